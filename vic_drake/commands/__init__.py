@@ -1,0 +1,1 @@
+"""Subcommands of ``vic-drake``; each module has ``register(subparsers)``."""
