@@ -56,7 +56,9 @@ def test_contact_loss_intervals_ignore_short_dips_and_free_motion():
     f[t > 9] = 0.0  # Lift-off: not a loss.
     df = make_scan(t, f)
     (loss,) = contact_loss_intervals(df)
-    assert loss[0] == pytest.approx(5.0, abs=0.003) and loss[1] == pytest.approx(6.0, abs=0.003)
+    assert loss[0] == pytest.approx(5.0, abs=0.003) and loss[1] == pytest.approx(
+        6.0, abs=0.003
+    )
     assert lifted_off(df)
     cmp = compare_contact_loss(df, df)
     assert cmp["contact_loss_overlap_s"] == pytest.approx(1.0, abs=0.005)
@@ -83,7 +85,9 @@ def test_compare_identical_records_is_perfect():
     t = np.arange(0, 10, 0.002)
     f = np.where(t < 1, 0.0, 7 + np.sin(t))
     k = 300 + 100 * np.sin(0.5 * t)
-    df = make_scan(t, f, z_m=0.1 + 0.001 * np.sin(t), stiffness_z_N_per_m=k, tank_energy_J=0.5)
+    df = make_scan(
+        t, f, z_m=0.1 + 0.001 * np.sin(t), stiffness_z_N_per_m=k, tank_energy_J=0.5
+    )
     out = compare_with_real(df, df)
     assert out["force_rmse_N"] == pytest.approx(0.0, abs=1e-12)
     assert out["z_rmse_mm"] == pytest.approx(0.0, abs=1e-12)
@@ -101,7 +105,9 @@ def test_penetration_stats_split_ribs_from_soft_tissue():
     df = make_scan(t, np.full_like(t, 7.0), x_m=x, y_m=y, penetration_m=pen)
     stats = penetration_stats(df, phantom)
     assert stats.rib_samples > 0 and stats.soft_samples > stats.rib_samples
-    assert stats.rib_mean_m == pytest.approx(0.003) and stats.soft_mean_m == pytest.approx(0.008)
+    assert stats.rib_mean_m == pytest.approx(
+        0.003
+    ) and stats.soft_mean_m == pytest.approx(0.008)
 
 
 def test_lift_estimate_recovers_a_lift_on_a_flat_phantom():
@@ -109,7 +115,12 @@ def test_lift_estimate_recovers_a_lift_on_a_flat_phantom():
     xs, ys = np.linspace(-0.2, 0.1, 31), np.linspace(-0.45, -0.28, 18)
     kappa = np.full((31, 18), 4000.0)
     phantom = GridPhantom(
-        x_m=xs, y_m=ys, z_m=np.full((31, 18), 0.1), kappa=kappa, lam=kappa * 10, beta=1.35
+        x_m=xs,
+        y_m=ys,
+        z_m=np.full((31, 18), 0.1),
+        kappa=kappa,
+        lam=kappa * 10,
+        beta=1.35,
     )
     t = np.arange(0, 20, 0.002)
     lift = 0.015 * np.clip(np.minimum(t - 5, 9 - t), 0, 1)  # Trapezoid 5-10 s.
@@ -132,7 +143,9 @@ def test_real_logs_convert_to_the_canonical_layout(data_dir):
     # VS-CF at a 7 N reference: the real controller tracked it to within ~1 N.
     assert force_rmse_N(real) < 1.5
     assert tank_min_J(real) == pytest.approx(0.9708, abs=1e-3)
-    cs = real_to_canonical(read_bag(data_dir / "experiments" / "test_compliance_control400"))
+    cs = real_to_canonical(
+        read_bag(data_dir / "experiments" / "test_compliance_control400")
+    )
     assert np.isnan(cs["x_d_m"]).all() and (cs["force_sensor_z_N"] < 0).all()
     with pytest.raises(VicDrakeError, match="layout"):
         real_to_canonical(read_bag(data_dir / "palpation" / "test_soft_1hz"))

@@ -114,15 +114,21 @@ def real_to_canonical(df: pd.DataFrame) -> pd.DataFrame:
             out[dst] = df[src].to_numpy()
         out["surface_z_m"] = df["penetration_m"].to_numpy() + df["z_m"].to_numpy()
         dt = np.gradient(df["t_s"].to_numpy())
-        out["tank_power_W"] = df["tank_delta_J"].to_numpy() / np.where(dt > 0, dt, np.nan)
-        out["in_contact"] = (df["sensor_force_z_N"].to_numpy() < -CONTACT_THRESHOLD_N).astype(float)
+        out["tank_power_W"] = df["tank_delta_J"].to_numpy() / np.where(
+            dt > 0, dt, np.nan
+        )
+        out["in_contact"] = (
+            df["sensor_force_z_N"].to_numpy() < -CONTACT_THRESHOLD_N
+        ).astype(float)
         out["phantom_lift_m"] = 0.0
     elif layout == "scan":
         for c in ("x_m", "y_m", "z_m"):
             out[c] = df[c].to_numpy()
         out["z_d_m"] = df["z_target_m"].to_numpy()
         out["force_sensor_z_N"] = -df["force_pressing_z_N"].to_numpy()
-        out["in_contact"] = (df["force_pressing_z_N"].to_numpy() > CONTACT_THRESHOLD_N).astype(float)
+        out["in_contact"] = (
+            df["force_pressing_z_N"].to_numpy() > CONTACT_THRESHOLD_N
+        ).astype(float)
     else:
         raise VicDrakeError(
             f"real_to_canonical takes a scan log ('controller' 31-column or 'scan' 9-column "
@@ -139,13 +145,19 @@ def pressing_force_N(df: pd.DataFrame) -> np.ndarray:
     return -df["force_sensor_z_N"].to_numpy(dtype=float)
 
 
-def contact_mask(df: pd.DataFrame, threshold_N: float = CONTACT_THRESHOLD_N) -> np.ndarray:
+def contact_mask(
+    df: pd.DataFrame, threshold_N: float = CONTACT_THRESHOLD_N
+) -> np.ndarray:
     """True where the pressing force exceeds the contact threshold."""
     return pressing_force_N(df) > threshold_N
 
 
-def scan_window(df: pd.DataFrame, *, settle_s: float = SETTLE_S,
-                threshold_N: float = CONTACT_THRESHOLD_N) -> np.ndarray:
+def scan_window(
+    df: pd.DataFrame,
+    *,
+    settle_s: float = SETTLE_S,
+    threshold_N: float = CONTACT_THRESHOLD_N,
+) -> np.ndarray:
     """Samples of the scan proper: from first contact + settle_s to last contact.
 
     Returns an all-False mask when the probe never touched.
@@ -249,7 +261,9 @@ def penetration_stats(
     """
     _require(df, "x_m", "y_m", "penetration_m")
     mask = scan_window(df)
-    kappa = np.asarray(phantom.kappa(df["x_m"].to_numpy(float), df["y_m"].to_numpy(float)))
+    kappa = np.asarray(
+        phantom.kappa(df["x_m"].to_numpy(float), df["y_m"].to_numpy(float))
+    )
     pen = df["penetration_m"].to_numpy(float)
     ok = mask & np.isfinite(pen)
     rib = ok & (kappa > rib_kappa_threshold)
@@ -277,8 +291,9 @@ def liftoff_clearance_m(df: pd.DataFrame, *, tail_s: float = 0.5) -> float:
     return float(-np.nanmean(pen)) if np.isfinite(pen).any() else float("nan")
 
 
-def lifted_off(df: pd.DataFrame, *, tail_s: float = 0.5,
-               threshold_N: float = CONTACT_THRESHOLD_N) -> bool:
+def lifted_off(
+    df: pd.DataFrame, *, tail_s: float = 0.5, threshold_N: float = CONTACT_THRESHOLD_N
+) -> bool:
     """True when the probe is out of contact over the last tail_s of the run."""
     t = df["t_s"].to_numpy(float)
     tail = t >= t[-1] - tail_s
@@ -305,8 +320,12 @@ def resample(df: pd.DataFrame, t_s: np.ndarray, columns) -> dict[str, np.ndarray
 
 
 def estimate_time_offset_s(
-    sim: pd.DataFrame, real: pd.DataFrame, *, column: str = "force_sensor_z_N",
-    max_lag_s: float = 0.5, dt_s: float = 0.01,
+    sim: pd.DataFrame,
+    real: pd.DataFrame,
+    *,
+    column: str = "force_sensor_z_N",
+    max_lag_s: float = 0.5,
+    dt_s: float = 0.01,
 ) -> float:
     """Shift (s) to add to the simulated time to best match the real log.
 
@@ -364,7 +383,9 @@ def compare_with_real(
         tank_min_real_J (None if not logged).
     """
     _require(sim, *CANONICAL_COLUMNS[:10])
-    _require(real, "t_s", "z_m", "force_sensor_z_N", "stiffness_z_N_per_m", "tank_energy_J")
+    _require(
+        real, "t_s", "z_m", "force_sensor_z_N", "stiffness_z_N_per_m", "tank_energy_J"
+    )
     offset = estimate_time_offset_s(sim, real, max_lag_s=max_lag_s) if align else 0.0
     sim_s = shift_time(sim, offset)
     window = scan_window(real)
@@ -377,7 +398,9 @@ def compare_with_real(
             "the simulated and real scans do not overlap in the real log's contact window; "
             "simulate longer or check the scenario"
         )
-    f_err = s["force_sensor_z_N"][valid] - real["force_sensor_z_N"].to_numpy(float)[valid]
+    f_err = (
+        s["force_sensor_z_N"][valid] - real["force_sensor_z_N"].to_numpy(float)[valid]
+    )
     z_err = s["z_m"][valid] - real["z_m"].to_numpy(float)[valid]
     k_real = real["stiffness_z_N_per_m"].to_numpy(float)[valid]
     k_sim = s["stiffness_z_N_per_m"][valid]
@@ -442,7 +465,9 @@ def apparent_surface_z_m(df: pd.DataFrame, phantom) -> np.ndarray:
     f = pressing_force_N(df)
     x, y = df["x_m"].to_numpy(float), df["y_m"].to_numpy(float)
     kappa = np.asarray(phantom.kappa(x, y), float)
-    eps = np.where(f > CONTACT_THRESHOLD_N, np.maximum(f, 0.0) / kappa, np.nan) ** (1.0 / phantom.beta)
+    eps = np.where(f > CONTACT_THRESHOLD_N, np.maximum(f, 0.0) / kappa, np.nan) ** (
+        1.0 / phantom.beta
+    )
     return df["z_m"].to_numpy(float) + eps
 
 
@@ -488,13 +513,19 @@ def estimate_phantom_lift(
     n = max(1, int(round(smooth_s / dt)))
     measured = np.isfinite(raw)
     if measured.sum() < 2:
-        raise VicDrakeError("the disturbance log has no contact; cannot estimate a lift")
+        raise VicDrakeError(
+            "the disturbance log has no contact; cannot estimate a lift"
+        )
     filled = np.interp(t, t[measured], raw[measured])
     kernel = np.ones(n) / n
-    smooth = np.convolve(np.pad(filled, (n // 2, n - 1 - n // 2), mode="edge"), kernel, "valid")
+    smooth = np.convolve(
+        np.pad(filled, (n // 2, n - 1 - n // 2), mode="edge"), kernel, "valid"
+    )
     base_sel = measured & (t <= t[0] + baseline_s)
     base = float(np.median(smooth[base_sel])) if base_sel.any() else 0.0
-    return pd.DataFrame({"t_s": t, "phantom_lift_m": smooth - base, "measured": measured})
+    return pd.DataFrame(
+        {"t_s": t, "phantom_lift_m": smooth - base, "measured": measured}
+    )
 
 
 def lift_table(lift: pd.DataFrame, *, dt_s: float = 0.05) -> list[list[float]]:
