@@ -1,0 +1,89 @@
+"""The variable impedance controller: references + stiffness QP + energy tank.
+
+``MakeVariableImpedanceController(params, phantom=...)`` returns a Diagram
+named "variable_impedance_controller" composing
+
+- "force_reference" (:class:`ForceReferenceSystem`): contact, penetration
+  rate, F_ref, F_min, the FDCC target force,
+- "stiffness_qp" (:class:`StiffnessQpSystem`): K (QP or constant), D,
+  status, and the commit of its tick,
+- "energy_tank" (:class:`EnergyTankSystem`): T, power, sigma, enabled,
+
+all at ``params.period_s`` (500 Hz by default). All four controllers (CS,
+CF, VS-CF, VS-VF) expose the same ports; see
+:class:`vic_drake.control.params.ReferenceParams` for how each maps to
+(stiffness, target_force) of the compliance (FDCC) stage.
+"""
+
+from __future__ import annotations
+
+from pydrake.systems.framework import Diagram, DiagramBuilder
+
+from vic_drake.control.params import ControllerParams
+from vic_drake.errors import VicDrakeError
+from vic_drake.systems.references import ForceReferenceSystem
+from vic_drake.systems.stiffness_qp import STATUS_FIELDS, StiffnessQpSystem
+from vic_drake.systems.tank import EnergyTankSystem
+from vic_drake.tissue.phantom import Phantom
+
+#: Fields of the "tank" output.
+TANK_FIELDS = ("T_J", "power_W", "sigma", "enabled")
+
+__all__ = ["MakeVariableImpedanceController", "STATUS_FIELDS", "TANK_FIELDS"]
+
+
+def MakeVariableImpedanceController(
+    params: ControllerParams, *, phantom: Phantom
+) -> Diagram:
+    """Builds the online controller.
+
+    Args:
+        params: controller parameters (validated here again, so values loaded
+            from YAML are checked).
+        phantom: the tissue map the references read (surface, kappa, lam).
+
+    Returns:
+        Diagram "variable_impedance_controller" with
+        inputs: "ee_position" (3, p_WP, m), "ee_velocity" (3, m/s),
+        "target_position" (3, x_d, m), "measured_force" (3, N, in W, sensor
+        convention: negative z = pressing);
+        outputs: "stiffness" (3, N/m), "damping" (3, N s/m), "target_force"
+        (3, N), "force_reference" (3, N), "force_min" (3, N), "tank" (4:
+        T_J, power_W, sigma, enabled), "status" (6: qp_ok, fallback_count,
+        fault, in_contact, solve_time_s, penetration_m).
+    """
+    if not isinstance(params, ControllerParams):
+        raise VicDrakeError(
+            f"MakeVariableImpedanceController needs ControllerParams; got {params!r}"
+        )
+    if not isinstance(phantom, Phantom):
+        raise VicDrakeError(f"phantom must be a vic_drake Phantom; got {phantom!r}")
+    params.validate()
+    builder = DiagramBuilder()
+    ref = builder.AddNamedSystem(
+        "force_reference", ForceReferenceSystem(params, phantom=phantom)
+    )
+    qp = builder.AddNamedSystem("stiffness_qp", StiffnessQpSystem(params))
+    tank = builder.AddNamedSystem("energy_tank", EnergyTankSystem(params))
+
+    for name in ("ee_position", "ee_velocity"):
+        index = builder.ExportInput(ref.GetInputPort(name), name)
+        builder.ConnectInput(index, qp.GetInputPort(name))
+    builder.ExportInput(qp.GetInputPort("target_position"), "target_position")
+    builder.ExportInput(ref.GetInputPort("measured_force"), "measured_force")
+
+    for name in ("force_reference", "force_min", "contact"):
+        builder.Connect(ref.GetOutputPort(name), qp.GetInputPort(name))
+    builder.Connect(tank.get_energy_output_port(), qp.GetInputPort("tank_energy"))
+    builder.Connect(qp.get_commit_output_port(), tank.get_commit_input_port())
+
+    builder.ExportOutput(qp.get_stiffness_output_port(), "stiffness")
+    builder.ExportOutput(qp.get_damping_output_port(), "damping")
+    builder.ExportOutput(ref.get_target_force_output_port(), "target_force")
+    builder.ExportOutput(ref.get_force_reference_output_port(), "force_reference")
+    builder.ExportOutput(ref.get_force_min_output_port(), "force_min")
+    builder.ExportOutput(tank.get_tank_output_port(), "tank")
+    builder.ExportOutput(qp.get_status_output_port(), "status")
+    diagram = builder.Build()
+    diagram.set_name("variable_impedance_controller")
+    return diagram

@@ -1,0 +1,175 @@
+"""ForceReferenceSystem: contact, penetration rate and force references.
+
+A thin LeafSystem over :mod:`vic_drake.control.references`. The references
+are cheap algebra on the current measurement, so they are computed in an
+output cache entry (direct feedthrough, as the real controller computed
+them from the same sample as its QP); only the surface-velocity filter has
+state, advanced by a periodic discrete update at the controller rate.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from pydrake.common.value import AbstractValue
+from pydrake.systems.framework import BasicVector, LeafSystem, ValueProducer
+
+from vic_drake.control.params import ControllerParams
+from vic_drake.control.references import (
+    constant_stiffness,
+    force_references,
+    in_contact,
+    penetration,
+    penetration_rate,
+    surface_velocity_gradient,
+    surface_velocity_initial_state,
+    surface_velocity_step,
+)
+from vic_drake.tissue.phantom import Phantom
+
+
+def _finite3(v) -> bool:
+    return math.isfinite(v[0]) and math.isfinite(v[1]) and math.isfinite(v[2])
+
+
+class ForceReferenceSystem(LeafSystem):
+    """Force references of the selected controller (CS, CF, VS-CF, VS-VF).
+
+    Input ports:
+        ee_position (3): probe tip p_WP, m.
+        ee_velocity (3): v_WP, m/s.
+        measured_force (3): F/T force in W, N, sensor convention.
+
+    Output ports:
+        force_reference (3): F_ref, N (sensor convention).
+        force_min (3): F_min, N.
+        target_force (3): force the FDCC stage tracks, N (CF only).
+        contact (4): [in_contact (0/1), penetration_m, fault (0/1),
+            surface_velocity_m_per_s].
+
+    State: the surface-velocity filter (discrete, updated every period).
+    A non-finite input gives F_ref = 0, F_min = (F_min,x, F_min,y,
+    -F_max,z), target 0, in_contact 0 and fault 1 (never a NaN output).
+    """
+
+    def __init__(self, params: ControllerParams, *, phantom: Phantom):
+        super().__init__()
+        params.validate()
+        self._params = params
+        self._phantom = phantom
+        self._dt = float(params.period_s)
+        ref = params.reference
+        self._mode = ref.surface_velocity_mode
+        self._position_port = self.DeclareVectorInputPort("ee_position", 3)
+        self._velocity_port = self.DeclareVectorInputPort("ee_velocity", 3)
+        self._force_port = self.DeclareVectorInputPort("measured_force", 3)
+        self._filter_index = self.DeclareDiscreteState(
+            surface_velocity_initial_state(ref.surface_velocity_window)
+        )
+        self.DeclarePeriodicDiscreteUpdateEvent(self._dt, 0.0, self._update)
+        self._cache = self.DeclareCacheEntry(
+            "references",
+            ValueProducer(
+                allocate=lambda: AbstractValue.Make(object()), calc=self._calc
+            ),
+            {self.all_input_ports_ticket(), self.xd_ticket()},
+        )
+        self._outputs = {}
+        for name, size, start in (
+            ("force_reference", 3, 0),
+            ("force_min", 3, 3),
+            ("target_force", 3, 6),
+            ("contact", 4, 9),
+        ):
+            self._outputs[name] = self.DeclareVectorOutputPort(
+                name,
+                size,
+                self._make_output(start, size),
+                {self._cache.ticket()},
+            )
+
+    def _make_output(self, start: int, size: int):
+        def calc(context, output: BasicVector):
+            output.SetFromVector(self._cache.Eval(context)[0][start : start + size])
+
+        return calc
+
+    def _evaluate(self, context):
+        """(values (13,), new filter state) for the current inputs."""
+        p_WP = self._position_port.Eval(context)
+        v_WP = self._velocity_port.Eval(context)
+        f_W = self._force_port.Eval(context)
+        filt = context.get_discrete_state(self._filter_index).value()
+        ref, qp = self._params.reference, self._params.qp
+        if not (_finite3(p_WP) and _finite3(v_WP) and _finite3(f_W)):
+            values = np.zeros(13)
+            values[3:6] = (qp.force_min_N[0], qp.force_min_N[1], -qp.force_max_N[2])
+            values[11] = 1.0
+            return values, filt
+        sample = self._phantom.sample(p_WP[0], p_WP[1])
+        surface_z = float(sample.surface_z_m)
+        if self._mode == "moving_average":
+            new_filt, z_surf_dot = surface_velocity_step(filt, surface_z, self._dt)
+        else:
+            new_filt = filt
+            z_surf_dot = surface_velocity_gradient(
+                float(sample.dz_dx), float(sample.dz_dy), v_WP[0], v_WP[1]
+            )
+        contact = in_contact(f_W[2], ref)
+        refs = force_references(
+            contact=contact,
+            kappa=float(sample.kappa),
+            lam=float(sample.lam),
+            eps_dot=penetration_rate(v_WP[2], z_surf_dot),
+            beta=self._phantom.beta,
+            ref=ref,
+            qp=qp,
+        )
+        values = np.array(
+            [
+                *refs.force_ref,
+                *refs.force_min,
+                *refs.target_force,
+                1.0 if contact else 0.0,
+                penetration(surface_z, p_WP[2]),
+                0.0,
+                z_surf_dot,
+            ]
+        )
+        if not np.all(np.isfinite(values)):  # E.g. a phantom returning NaN.
+            values[:] = 0.0
+            values[3:6] = (qp.force_min_N[0], qp.force_min_N[1], -qp.force_max_N[2])
+            values[11] = 1.0
+        return values, new_filt
+
+    def _calc(self, context, value):
+        value.set_value(self._evaluate(context))
+
+    def _update(self, context, discrete_state):
+        _, new_filt = self._cache.Eval(context)
+        discrete_state.get_mutable_vector(self._filter_index).SetFromVector(new_filt)
+
+    def uses_constant_stiffness(self) -> bool:
+        return constant_stiffness(self._params.reference) is not None
+
+    def get_ee_position_input_port(self):
+        return self._position_port
+
+    def get_ee_velocity_input_port(self):
+        return self._velocity_port
+
+    def get_measured_force_input_port(self):
+        return self._force_port
+
+    def get_force_reference_output_port(self):
+        return self._outputs["force_reference"]
+
+    def get_force_min_output_port(self):
+        return self._outputs["force_min"]
+
+    def get_target_force_output_port(self):
+        return self._outputs["target_force"]
+
+    def get_contact_output_port(self):
+        return self._outputs["contact"]
