@@ -1,0 +1,273 @@
+"""Offline fits of the paper's Sec. III-A: ``fit-palpation`` and ``load-test``.
+
+``vic-drake fit-palpation BAG_DIR`` reads a 6-column palpation bag, estimates
+the force sensor's lag, aligns force and position, fits Kelvin-Voigt and
+Hunt-Crossley (at each ``--betas``) by least squares with the indenter-mass
+term, and sweeps beta over [1.0, 2.0] (Table I of the paper).
+
+``vic-drake load-test BAG_DIR --fit-from PALPATION_BAG_DIR`` fits both models
+on the palpation and predicts the load/unload test's force from its measured
+trajectory (Fig. 2), reporting each model's RMS error.
+
+Relative residual: RMS least-squares residual / RMS of the fitted force
+(F_sensor + m_I z_ddot) over the in-contact samples. The paper's Table I
+("relative residual value") does not define its number; compare the
+ordering of the models rather than the digits.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+
+from vic_drake.commands.common import (
+    Progress,
+    add_json_option,
+    emit,
+    parse_float_list,
+)
+from vic_drake.errors import DataNotFoundError, VicDrakeError
+from vic_drake.paths import resolve_data_dir
+
+_RELATIVE_HELP = (
+    "Relative residual = RMS residual / RMS fitted force over the in-contact "
+    "samples (the paper's Table I does not define its 'relative residual value'; "
+    "compare orderings, not digits)."
+)
+
+
+def _beta_key(beta: float) -> str:
+    """JSON key of a beta: the shortest repr of the float ("1.35", "1.0")."""
+    return repr(float(beta))
+
+
+def _parse_betas(text: str) -> list[float]:
+    betas = parse_float_list(text, "--betas")
+    for b in betas:
+        if not (math.isfinite(b) and 0.0 < b <= 3.0):
+            raise VicDrakeError(
+                f"--betas values must be in (0, 3]; got {b!r} in {text!r}"
+            )
+    # Keep order, drop repeats (they would collide as JSON keys).
+    return list(dict.fromkeys(betas))
+
+
+def _check_beta_option(beta: float, option: str) -> float:
+    if not (math.isfinite(beta) and 0.0 < beta <= 3.0):
+        raise VicDrakeError(f"{option} must be in (0, 3]; got {beta!r}")
+    return beta
+
+
+def _check_nonneg(value: float, option: str) -> float:
+    if not (math.isfinite(value) and value >= 0.0):
+        raise VicDrakeError(f"{option} must be a finite number >= 0; got {value!r}")
+    return value
+
+
+def _bag_path(text: str) -> Path:
+    """The bag folder as given, else relative to the data folder."""
+    path = Path(text).expanduser()
+    if path.exists() or path.is_absolute():
+        return path
+    candidate = resolve_data_dir() / path
+    return candidate if candidate.exists() else path
+
+
+def _read_palpation(text: str, role: str):
+    from vic_drake.estimation.palpation import PalpationData
+    from vic_drake.realdata import read_bag
+
+    path = _bag_path(text)
+    if not path.exists():
+        raise DataNotFoundError(
+            f"{role} {text!r} does not exist; expected a ROS 2 bag folder "
+            "(metadata.yaml + .db3) of the 6-column palpation/loadcycle layout"
+        )
+    df = read_bag(path, expect="palpation")
+    return PalpationData.from_frame(df)
+
+
+def _add_fit_options(parser: argparse.ArgumentParser) -> None:
+    from vic_drake.estimation.palpation import (
+        DEFAULT_INDENTER_MASS_KG,
+        DEFAULT_MAX_LAG_S,
+    )
+
+    parser.add_argument(
+        "--max-lag",
+        type=float,
+        default=DEFAULT_MAX_LAG_S,
+        metavar="S",
+        help="sensor-lag search range [0, S] seconds (default %(default)s)",
+    )
+    parser.add_argument(
+        "--lag",
+        type=float,
+        default=None,
+        metavar="S",
+        help="use this sensor lag (s) instead of estimating it",
+    )
+    parser.add_argument(
+        "--indenter-mass",
+        type=float,
+        default=DEFAULT_INDENTER_MASS_KG,
+        metavar="KG",
+        help="indenter mass m_I below the sensing element, kg (default %(default)s: "
+        "the BOTA SensONE wrench-side mass)",
+    )
+
+
+def _fit_palpation(args: argparse.Namespace) -> int:
+    from vic_drake.estimation.palpation import compare_models
+
+    betas = _parse_betas(args.betas)
+    max_lag = _check_nonneg(args.max_lag, "--max-lag")
+    lag = None if args.lag is None else _check_nonneg(args.lag, "--lag")
+    mass = _check_nonneg(args.indenter_mass, "--indenter-mass")
+    say = Progress()
+    say(f"reading {args.bag_dir}")
+    data = _read_palpation(args.bag_dir, "palpation bag")
+    result = compare_models(
+        data,
+        betas,
+        lag_s=lag,
+        max_lag_s=max_lag,
+        indenter_mass_kg=mass,
+        progress=say,
+    )
+    kv = result.kelvin_voigt
+    out = {
+        "lag_s": result.lag_s,
+        "kelvin_voigt": {
+            "rms_N": kv.rms_N,
+            "relative": kv.relative,
+            "k": kv.k,
+            "d": kv.d,
+        },
+        "hunt_crossley": {
+            _beta_key(b): {
+                "rms_N": f.rms_N,
+                "relative": f.relative,
+                "kappa": f.kappa,
+                "lambda": f.lam,
+            }
+            for b, f in result.hunt_crossley.items()
+        },
+        "best_beta": result.best_beta,
+    }
+    if args.plot:
+        from vic_drake.plots.offline import plot_palpation_summary
+
+        plot_palpation_summary(result, title=str(args.bag_dir), save_path=args.plot)
+        say(f"wrote {args.plot}")
+    lines = [
+        f"palpation {args.bag_dir}: {kv.n_samples} in-contact samples",
+        f"sensor lag {result.lag_s * 1e3:.1f} ms (force behind position)",
+        f"{'model':<22}{'rms [N]':>10}{'relative':>10}   parameters",
+        f"{'Kelvin-Voigt':<22}{kv.rms_N:>10.4f}{kv.relative:>10.4f}   "
+        f"k = {kv.k:.1f} N/m, d = {kv.d:.2f} N s/m",
+    ]
+    for b, f in result.hunt_crossley.items():
+        lines.append(
+            f"{'Hunt-Crossley b=' + _beta_key(b):<22}{f.rms_N:>10.4f}{f.relative:>10.4f}   "
+            f"kappa = {f.kappa:.1f}, lambda = {f.lam:.1f}"
+        )
+    lines.append(f"best beta in [1.0, 2.0]: {result.best_beta:.3f}")
+    lines.append(_RELATIVE_HELP)
+    emit(out, args.json, "\n".join(lines))
+    return 0
+
+
+def _load_test(args: argparse.Namespace) -> int:
+    from vic_drake.estimation.loadtest import load_test
+
+    beta = _check_beta_option(args.beta, "--beta")
+    max_lag = _check_nonneg(args.max_lag, "--max-lag")
+    lag = None if args.lag is None else _check_nonneg(args.lag, "--lag")
+    mass = _check_nonneg(args.indenter_mass, "--indenter-mass")
+    say = Progress()
+    say(f"reading {args.bag_dir} and {args.fit_from}")
+    load = _read_palpation(args.bag_dir, "load-test bag")
+    palpation = _read_palpation(args.fit_from, "--fit-from palpation bag")
+    result = load_test(
+        load,
+        palpation,
+        beta=beta,
+        lag_s=lag,
+        max_lag_s=max_lag,
+        indenter_mass_kg=mass,
+        progress=say,
+    )
+    out = {
+        "kelvin_voigt_rms_N": result.kelvin_voigt_rms_N,
+        "hunt_crossley_rms_N": result.hunt_crossley_rms_N,
+        "beta": result.beta,
+    }
+    if args.plot:
+        from vic_drake.plots.offline import plot_load_test
+
+        plot_load_test(result, title=str(args.bag_dir), save_path=args.plot)
+        say(f"wrote {args.plot}")
+    kv, hc = result.kelvin_voigt, result.hunt_crossley
+    human = "\n".join(
+        [
+            f"load test {args.bag_dir}, models fitted on {args.fit_from}",
+            f"sensor lag {result.lag_s * 1e3:.1f} ms; {int(result.mask.sum())} samples "
+            "in contact",
+            f"Kelvin-Voigt (k = {kv.k:.1f} N/m, d = {kv.d:.2f} N s/m): "
+            f"RMS error {result.kelvin_voigt_rms_N:.3f} N",
+            f"Hunt-Crossley beta = {result.beta:g} (kappa = {hc.kappa:.1f}, "
+            f"lambda = {hc.lam:.1f}): RMS error {result.hunt_crossley_rms_N:.3f} N",
+        ]
+    )
+    emit(out, args.json, human)
+    return 0
+
+
+def register(subparsers) -> None:
+    """Adds ``fit-palpation`` and ``load-test``."""
+    p = subparsers.add_parser(
+        "fit-palpation",
+        help="fit Kelvin-Voigt and Hunt-Crossley to a palpation bag (Table I)",
+        description=__doc__.split("\n\n")[1] + " " + _RELATIVE_HELP,
+    )
+    p.add_argument(
+        "bag_dir",
+        metavar="BAG_DIR",
+        help="6-column palpation bag folder (absolute, relative, or relative to the "
+        "data folder, e.g. palpation/test_soft_1hz)",
+    )
+    p.add_argument(
+        "--betas",
+        default="1.1,1.35,1.5",
+        metavar="B1,B2,...",
+        help="Hunt-Crossley exponents to report, each in (0, 3] (default %(default)s)",
+    )
+    _add_fit_options(p)
+    p.add_argument("--plot", default=None, metavar="FILE", help="save a summary figure")
+    add_json_option(p)
+    p.set_defaults(handler=_fit_palpation)
+
+    q = subparsers.add_parser(
+        "load-test",
+        help="predict a load/unload test with models fitted on a palpation (Fig. 2)",
+        description=__doc__.split("\n\n")[2],
+    )
+    q.add_argument("bag_dir", metavar="BAG_DIR", help="6-column load-test bag folder")
+    q.add_argument(
+        "--fit-from",
+        required=True,
+        metavar="PALPATION_BAG_DIR",
+        help="palpation bag the model parameters are fitted on",
+    )
+    q.add_argument(
+        "--beta",
+        type=float,
+        default=1.35,
+        help="Hunt-Crossley exponent, in (0, 3] (default %(default)s)",
+    )
+    _add_fit_options(q)
+    q.add_argument("--plot", default=None, metavar="FILE", help="save the Fig. 2 plot")
+    add_json_option(q)
+    q.set_defaults(handler=_load_test)
