@@ -56,6 +56,12 @@ def test_c2_flat_or_rising_residual_fails():
     flat = 0.02 + 1e-3 * rng.standard_normal(t.size)
     assert not C.claim_c2((t, flat), None).pass_sim
     assert not C.claim_c2((t, 0.01 + 0.001 * t), None).pass_sim
+    # Monotone and exponential but falling only 5 %: not a fall.
+    assert not C.claim_c2((t, 0.02 + 0.001 * np.exp(-t / 4.0)), None).pass_sim
+    # Per-log curves: every log must pass.
+    good = (t, 0.01 + 0.05 * np.exp(-t / 4.0))
+    assert C.claim_c2({"a": good, "b": good}, None).pass_sim
+    assert not C.claim_c2({"a": good, "b": (t, flat)}, None).pass_sim
     # A linear fall is monotone but the exponential still fits it (tau large);
     # R^2 is what separates "exponential" from noise, not from lines.
     with pytest.raises(VicDrakeError, match="length"):

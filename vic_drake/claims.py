@@ -44,6 +44,10 @@ C2_MAX_SPEARMAN = -0.8
 #: C2: the exponential model r(T) = c + a exp(-T/tau) must explain at least
 #: this fraction of the variance ("about exponentially", Fig. 3).
 C2_MIN_R2 = 0.9
+#: C2: the residual at the longest palpation must be at most this fraction of
+#: the shortest one's: a fall, not a flat curve with a monotone wiggle (the
+#: paper's Fig. 3 falls several-fold).
+C2_MAX_RATIO = 0.8
 #: C3: a kappa peak counts as a rib when its prominence (above the higher of
 #: its two neighbouring troughs) is at least this fraction of the map's median
 #: kappa; the measured map's weakest rib (under the muscle) has ~9 %, texture
@@ -300,6 +304,7 @@ def _c2_pass(d: dict) -> bool:
         and np.isfinite(d["r2"])
         and d["r2"] >= C2_MIN_R2
         and d["a"] > 0
+        and d["ratio_last_first"] <= C2_MAX_RATIO
     )
 
 
@@ -308,21 +313,32 @@ def claim_c2(sim: tuple | None, real: tuple | None, *, reason_sim: str | None = 
     """C2: residual vs palpation time falls about exponentially.
 
     Args:
-        sim, real: (duration_s, residual) arrays, or None.
+        sim, real: (duration_s, residual) arrays, or {log name: (duration_s,
+            residual)} (each log must pass), or None.
 
     Passes on a side when Spearman rho <= -0.8 and the exponential model has
     R^2 >= 0.9 with a positive amplitude.
     """
-    sv = residual_decay(*sim) if sim is not None else None
-    rv = residual_decay(*real) if real is not None else None
+    def side(curves):
+        if curves is None:
+            return None, None
+        if not isinstance(curves, Mapping):
+            d = residual_decay(*curves)
+            return d, _c2_pass(d)
+        per_log = {name: residual_decay(*c) for name, c in curves.items()}
+        for d in per_log.values():
+            d["pass"] = _c2_pass(d)
+        return per_log, all(d["pass"] for d in per_log.values())
+
+    sv, sp = side(sim)
+    rv, rp = side(real)
     detail = (f"fit r(T)=c+a exp(-T/tau); pass: spearman <= {C2_MAX_SPEARMAN}, "
-              f"R^2 >= {C2_MIN_R2}, a > 0")
+              f"R^2 >= {C2_MIN_R2}, a > 0, r(T_max)/r(T_min) <= {C2_MAX_RATIO} (every log)")
     extra = _not_evaluated(reason_sim if sim is None else None,
                            reason_real if real is None else None)
     return Claim("C2", STATEMENTS["C2"],
                  "residual decreases exponentially with palpation time; 5 s chosen",
-                 _clean(sv), _clean(rv),
-                 _c2_pass(sv) if sv else None, _c2_pass(rv) if rv else None,
+                 _clean(sv), _clean(rv), sp, rp,
                  "; ".join(p for p in (detail, extra) if p))
 
 
