@@ -21,8 +21,9 @@ Pipeline used by ``vic-drake fit-palpation``:
 
 1. :func:`estimate_lag`: the force sample of time t belongs to the position
    of time t - lag. The lag is a property of the sensor chain, so it is found
-   once per log: the force is advanced by each candidate lag on a grid of one
-   sample period over [0, max_lag_s], the reference model (Hunt-Crossley at
+   once per log: each force sample is paired with the (smoothed) kinematics
+   one candidate lag earlier, on a grid of one sample period over
+   [0, max_lag_s], the reference model (Hunt-Crossley at
    beta = 1.35, the paper's choice) is refitted, and the lag with the smallest
    RMS residual wins (parabolic refinement between grid points). All models
    are then compared at that one lag. Caveat: at a single palpation frequency
@@ -62,7 +63,6 @@ from vic_drake.errors import VicDrakeError
 from vic_drake.estimation.signals import (
     DEFAULT_DERIVATIVE_WINDOW_S,
     median_period,
-    shift_signal,
     smoothed_derivatives,
 )
 
@@ -203,29 +203,40 @@ class PalpationData:
 def shift(data: PalpationData, lag_s: float) -> PalpationData:
     """Aligns force with position when the force lags by ``lag_s`` seconds.
 
-    The returned force at time t is the logged force at t + lag_s (linear
-    interpolation between samples, so fractional lags work on uneven
-    timestamps); the last samples, whose aligned force is past the end of the
-    log, are dropped. ``lag_s = 0`` returns ``data``.
+    Each force sample, logged at t, is paired with the position of time
+    t - lag_s: the returned log has timestamps t - lag_s, the logged forces
+    untouched, and z (surface, target) linearly interpolated at t - lag_s.
+    Interpolating the smooth position rather than the noisy force keeps the
+    force noise intact, so residuals at different lags stay comparable
+    (interpolating the force would average its noise at fractional lags and
+    bias a fit-quality lag search). Samples with t - lag_s before the first
+    timestamp are dropped. ``lag_s = 0`` returns ``data``.
     """
     lag_s = float(lag_s)
     if not math.isfinite(lag_s):
         raise VicDrakeError(f"lag_s must be finite; got {lag_s!r}")
     if lag_s == 0.0:
         return data
-    force = shift_signal(data.t_s, data.force_N, lag_s)
-    keep = np.isfinite(force)
+    t_new = data.t_s - lag_s
+    keep = (t_new >= data.t_s[0]) & (t_new <= data.t_s[-1])
     if keep.sum() < 2:
         raise VicDrakeError(
             f"a lag of {lag_s} s leaves fewer than 2 samples of a {data.duration_s:.3f} s log"
         )
-    shifted = data.select(keep)
+    t_new = t_new[keep]
+    surface = data.surface_z_m
+    if not np.isscalar(surface):
+        surface = np.interp(t_new, data.t_s, surface)
     return PalpationData(
-        t_s=shifted.t_s,
-        z_m=shifted.z_m,
-        force_N=force[keep],
-        surface_z_m=shifted.surface_z_m,
-        z_target_m=shifted.z_target_m,
+        t_s=t_new,
+        z_m=np.interp(t_new, data.t_s, data.z_m),
+        force_N=data.force_N[keep],
+        surface_z_m=surface,
+        z_target_m=(
+            None
+            if data.z_target_m is None
+            else np.interp(t_new, data.t_s, data.z_target_m)
+        ),
     )
 
 
@@ -616,10 +627,12 @@ def lag_profile(
 ) -> LagProfile:
     """Reference-fit RMS residual over lags 0, dt, 2 dt, ... max_lag_s.
 
-    For each candidate the force is advanced by the lag (:func:`shift`), the
-    contact samples are reselected and Hunt-Crossley at ``beta`` is refitted.
-    Samples in the last ``max_lag_s`` of the log are left out for every
-    candidate, so all candidates are scored on the same time span.
+    For each candidate the force samples are paired with the smoothed
+    kinematics ``lag`` earlier (as :func:`shift` does), the contact samples
+    are reselected and Hunt-Crossley at ``beta`` is refitted.
+    Force samples in the first ``max_lag_s`` of the log are left out for
+    every candidate, so all candidates are scored on the same force samples
+    (the contact test on penetration still follows the lag).
     """
     max_lag_s = float(max_lag_s)
     if not (math.isfinite(max_lag_s) and max_lag_s >= 0.0):
@@ -633,20 +646,16 @@ def lag_profile(
     dt = median_period(data.t_s)
     lags = dt * np.arange(int(np.floor(max_lag_s / dt + 1e-9)) + 1)
     kin = kinematics(data, window_s=derivative_window_s)
-    span = data.t_s <= data.t_s[-1] - max_lag_s
-    rms = np.empty(lags.size)
-    for i, lag in enumerate(lags):
-        force = shift_signal(data.t_s, data.force_N, lag) if lag > 0 else data.force_N
-        force = np.where(span, force, 0.0)
-        shifted = PalpationData(data.t_s, data.z_m, force, data.surface_z_m)
-        mask = contact_mask(
-            shifted,
-            kin,
-            min_penetration_m=min_penetration_m,
-            min_force_N=min_force_N,
-            spike_sigma=spike_sigma,
-        )
-        mask &= span
+    # Force samples whose position is inside the log for every candidate.
+    span = data.t_s >= data.t_s[0] + max_lag_s
+    if spike_sigma is not None:
+        span &= spike_mask(data.force_N, sigma=spike_sigma)
+    span &= data.force_N > min_force_N
+
+    def score(lag: float) -> float:
+        t_pos = data.t_s - lag
+        eps = np.interp(t_pos, data.t_s, kin.eps_m)
+        mask = span & (eps > min_penetration_m)
         n = int(mask.sum())
         if n < MIN_CONTACT_SAMPLES:
             raise VicDrakeError(
@@ -654,16 +663,26 @@ def lag_profile(
                 f"{min_penetration_m * 1e3:g} mm and force > {min_force_N:g} N); "
                 f"a fit needs at least {MIN_CONTACT_SAMPLES}"
             )
-        p = _Problem(kin.eps_m, kin.eps_dot_m_per_s, kin.z_ddot_m_per_s2, force, mask)
-        rms[i] = _fit_hc(p, beta, mass).rms_N
+        p = _Problem(
+            eps,
+            np.interp(t_pos, data.t_s, kin.eps_dot_m_per_s),
+            np.interp(t_pos, data.t_s, kin.z_ddot_m_per_s2),
+            data.force_N,
+            mask,
+        )
+        return _fit_hc(p, beta, mass).rms_N
+
+    rms = np.array([score(lag) for lag in lags])
     best = int(np.argmin(rms))
     lag = float(lags[best])
-    if 0 < best < lags.size - 1:
-        # Parabola through the minimum and its neighbours.
-        r0, r1, r2 = rms[best - 1], rms[best], rms[best + 1]
-        denom = r0 - 2.0 * r1 + r2
-        if denom > 0.0:
-            lag += 0.5 * dt * (r0 - r2) / denom
+    if lags.size > 1:
+        # Continuous refinement between the grid neighbours (Brent).
+        lo, hi = lags[max(best - 1, 0)], lags[min(best + 1, lags.size - 1)]
+        res = minimize_scalar(
+            score, bounds=(lo, hi), method="bounded", options={"xatol": 1e-5}
+        )
+        if res.fun < rms[best]:
+            lag = float(res.x)
     return LagProfile(lags_s=lags, rms_N=rms, lag_s=lag, beta=beta)
 
 
