@@ -1,0 +1,80 @@
+"""The Hunt-Crossley force element at the probe tip."""
+
+import numpy as np
+import pytest
+from pydrake.math import RigidTransform, RotationMatrix
+from pydrake.multibody.math import SpatialVelocity
+from pydrake.multibody.tree import BodyIndex
+
+from vic_drake.systems.tissue_force import TissueForceElement, tip_contact
+from vic_drake.tissue import GridPhantom, hunt_crossley_force
+
+
+def _plane_phantom(z0=0.1, gx=0.2, gy=-0.1, kappa=3000.0, lam=30000.0):
+    """A tilted plane z = z0 + gx x + gy y with uniform kappa, lambda."""
+    xs = np.linspace(-0.2, 0.2, 41)
+    ys = np.linspace(-0.2, 0.2, 41)
+    X, Y = np.meshgrid(xs, ys, indexing="ij")
+    return GridPhantom(
+        x_m=xs, y_m=ys, z_m=z0 + gx * X + gy * Y,
+        kappa=np.full(X.shape, kappa), lam=np.full(X.shape, lam), beta=1.35,
+    )
+
+
+def test_penetration_and_force_match_the_law():
+    ph = _plane_phantom()
+    p = np.array([0.01, -0.02, 0.09])
+    v = np.array([0.01, 0.02, -0.03])
+    c = tip_contact(ph, p, v)
+    surface = 0.1 + 0.2 * 0.01 - 0.1 * -0.02
+    assert c.surface_z_m == pytest.approx(surface, abs=1e-12)
+    assert c.penetration_m == pytest.approx(surface - 0.09, abs=1e-12)
+    eps_dot = 0.2 * 0.01 - 0.1 * 0.02 + 0.03
+    assert c.penetration_rate_m_per_s == pytest.approx(eps_dot, abs=1e-12)
+    expected = hunt_crossley_force(c.penetration_m, eps_dot, 3000.0, 30000.0, 1.35)
+    assert c.force_N == pytest.approx(float(expected), rel=1e-12)
+
+
+def test_penetration_rate_is_the_time_derivative_with_a_moving_phantom():
+    ph = _plane_phantom()
+    p0, v = np.array([0.0, 0.01, 0.095]), np.array([0.02, -0.01, -0.004])
+    lift0, lift_v = np.array([0.0, 0.0, 0.003]), np.array([0.0, 0.0, 0.05])
+    h = 1e-6
+    c0 = tip_contact(ph, p0, v, lift0, lift_v)
+    c1 = tip_contact(ph, p0 + h * v, v, lift0 + h * lift_v, lift_v)
+    fd = (c1.penetration_m - c0.penetration_m) / h
+    assert c0.penetration_rate_m_per_s == pytest.approx(fd, rel=1e-6)
+
+
+def test_no_force_out_of_contact_and_no_pull():
+    ph = _plane_phantom()
+    above = tip_contact(ph, [0, 0, 0.11], [0, 0, 0])
+    assert above.force_N == 0.0 and above.penetration_m < 0
+    # Retracting fast: the raw law would pull; the element never does.
+    retract = tip_contact(ph, [0, 0, 0.099], [0, 0, 1.0])
+    assert retract.penetration_m > 0 and retract.force_N == 0.0
+
+
+def test_system_applies_force_at_tip_and_reaction_on_phantom():
+    ph = _plane_phantom(gx=0.0, gy=0.0)
+    p_BT = np.array([0.0, 0.0, 0.07])
+    system = TissueForceElement(
+        ph, indenter_body_index=BodyIndex(1), p_BT=p_BT, phantom_body_index=BodyIndex(2)
+    )
+    context = system.CreateDefaultContext()
+    X_WB = RigidTransform(RotationMatrix.MakeXRotation(np.pi), [0.01, 0.02, 0.09 + 0.07])
+    # Tool pointing down: tip at z = 0.09, 1 cm deep.
+    poses = [RigidTransform(), X_WB, RigidTransform([0, 0, 0.0])]
+    vels = [SpatialVelocity.Zero()] * 3
+    system.get_body_poses_input_port().FixValue(context, poses)
+    system.get_body_spatial_velocities_input_port().FixValue(context, vels)
+    forces = system.get_spatial_forces_output_port().Eval(context)
+    expected = float(hunt_crossley_force(0.01, 0.0, 3000.0, 30000.0, 1.35))
+    assert system.get_penetration_output_port().Eval(context)[0] == pytest.approx(0.01)
+    np.testing.assert_allclose(system.get_force_output_port().Eval(context), [0, 0, expected])
+    on_tip, on_phantom = forces
+    assert int(on_tip.body_index) == 1 and int(on_phantom.body_index) == 2
+    np.testing.assert_allclose(on_tip.p_BoBq_B, p_BT)
+    np.testing.assert_allclose(on_tip.F_Bq_W.translational(), [0, 0, expected])
+    np.testing.assert_allclose(on_phantom.F_Bq_W.translational(), [0, 0, -expected])
+    np.testing.assert_allclose(on_phantom.p_BoBq_B, [0.01, 0.02, 0.09])

@@ -1,0 +1,182 @@
+"""The BOTA SensONE force/torque sensor: weld reaction, tare, noise, bias, lag.
+
+The sensor is a weld joint between its mounting-side body (on the flange)
+and its wrench-side body (carrying the indenter). Drake's reaction force of
+that weld is exactly what a strain-gauge sensor measures: the spatial force
+the mounting side exerts on everything beyond it (wrench side, indenter and
+whatever touches the indenter), at the wrench frame S, expressed in S.
+
+Reading pipeline (every ``period_s``, 500 Hz on the rig):
+
+1. reaction ``F_S = [tau; f]`` of the weld, in S;
+2. tare: subtract the static load of the distal mass in the current
+   orientation (its weight held up by the sensor), so the reading is zero
+   in free air at rest in any orientation;
+3. add zero-mean Gaussian noise (standard deviations per axis);
+4. delay by ``lag_samples`` periods (the real sensor's filter lag, about
+   28 samples at 500 Hz), then add a constant bias.
+
+Sign convention: the reading is the force the sensor applies to the tool
+side. When the probe presses down into the body the tissue pushes the tool
+up and the sensor holds it down, so the z force expressed in the world frame
+is negative -- the convention of the real logs' sensor columns.
+Component order of wrenches is Drake's ``[tau_x, tau_y, tau_z, f_x, f_y, f_z]``
+(N m, N).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from pydrake.common.value import AbstractValue
+from pydrake.math import RigidTransform
+from pydrake.multibody.math import SpatialForce
+from pydrake.multibody.tree import BodyIndex, JointIndex
+from pydrake.systems.framework import BasicVector, LeafSystem
+
+from vic_drake.errors import VicDrakeError
+
+
+def tared_sensor_wrench(
+    F_S, R_WS, *, distal_mass_kg: float, p_SScm, gravity_W=(0.0, 0.0, -9.81)
+) -> np.ndarray:
+    """Removes the distal mass's static load from a sensor wrench.
+
+    Args:
+        F_S: measured wrench ``[tau; f]`` at S's origin, expressed in S (6,).
+        R_WS: orientation of S in W (3, 3).
+        distal_mass_kg: mass beyond the sensor (wrench side + tool), kg.
+        p_SScm: its centre of mass from S's origin, in S, m (3,).
+        gravity_W: gravity in W, m/s^2.
+
+    Returns:
+        The tared wrench ``[tau; f]`` in S (6,): zero in static free air.
+    """
+    F_S = np.asarray(F_S, float)
+    g_S = np.asarray(R_WS, float).T @ np.asarray(gravity_W, float)
+    f_static = -distal_mass_kg * g_S  # the sensor holds the weight up
+    tau_static = np.cross(np.asarray(p_SScm, float), f_static)
+    return F_S - np.concatenate([tau_static, f_static])
+
+
+class ForceTorqueSensor(LeafSystem):
+    """Samples, tares, corrupts and delays the weld reaction (module doc).
+
+    Input ports:
+        reaction_forces: ``list[SpatialForce]`` (the plant's reaction forces
+            port, indexed by joint index).
+        body_poses: ``list[RigidTransform]`` (the plant's body poses port).
+        noise: (6,) standard-normal samples (e.g. a RandomSource); if left
+            unconnected the reading is noise free.
+    Output ports:
+        wrench_S: (6,) reading ``[tau; f]`` in the sensor frame S (N m, N).
+        force_W: (3,) the reading's force expressed in W with the current
+            orientation of S, N (negative z = pressing down into the body).
+    State: a discrete buffer of the last ``lag_samples + 1`` tared samples.
+    """
+
+    def __init__(
+        self,
+        *,
+        weld_joint_index: JointIndex,
+        child_body_index: BodyIndex,
+        X_CS: RigidTransform,
+        distal_mass_kg: float,
+        p_SScm,
+        period_s: float = 0.002,
+        lag_samples: int = 0,
+        noise_std=(0.0,) * 6,
+        bias=(0.0,) * 6,
+        gravity_W=(0.0, 0.0, -9.81),
+    ):
+        """
+        Args:
+            weld_joint_index: the sensor weld (its reaction is the reading).
+            child_body_index: the weld's child body C (the wrench side).
+            X_CS: pose of the weld's child frame (= sensor frame S) in C.
+            distal_mass_kg: mass beyond the weld, kg (for the tare).
+            p_SScm: its centre of mass from S, in S, m.
+            period_s: sampling period, s.
+            lag_samples: delay in samples (>= 0).
+            noise_std: per-component noise std of ``[tau; f]`` (N m, N).
+            bias: constant offset added to ``[tau; f]`` after the delay.
+            gravity_W: gravity in W, m/s^2.
+        """
+        super().__init__()
+        if not (np.isfinite(period_s) and period_s > 0):
+            raise VicDrakeError(f"period_s must be > 0, got {period_s!r}")
+        if int(lag_samples) != lag_samples or lag_samples < 0:
+            raise VicDrakeError(f"lag_samples must be an integer >= 0, got {lag_samples!r}")
+        self._joint = int(weld_joint_index)
+        self._child = int(child_body_index)
+        self._R_CS = X_CS.rotation().matrix()
+        self._distal_mass = float(distal_mass_kg)
+        self._p_SScm = np.asarray(p_SScm, float).reshape(3)
+        self._noise_std = np.broadcast_to(np.asarray(noise_std, float), (6,)).copy()
+        self._bias = np.broadcast_to(np.asarray(bias, float), (6,)).copy()
+        self._gravity_W = np.asarray(gravity_W, float).reshape(3)
+        self._n = int(lag_samples) + 1
+        self._reaction_port = self.DeclareAbstractInputPort(
+            "reaction_forces", AbstractValue.Make([SpatialForce()])
+        )
+        self._poses_port = self.DeclareAbstractInputPort(
+            "body_poses", AbstractValue.Make([RigidTransform()])
+        )
+        self._noise_port = self.DeclareVectorInputPort("noise", 6)
+        self._buffer = self.DeclareDiscreteState(6 * self._n)
+        self.DeclarePeriodicDiscreteUpdateEvent(period_s, 0.0, self._update)
+        self._wrench_port = self.DeclareVectorOutputPort(
+            "wrench_S", 6, self._calc_wrench,
+            prerequisites_of_calc={self.xd_ticket()},
+        )
+        self._force_port = self.DeclareVectorOutputPort(
+            "force_W", 3, self._calc_force,
+            prerequisites_of_calc={self.xd_ticket(), self._poses_port.ticket()},
+        )
+
+    def get_reaction_forces_input_port(self):
+        return self._reaction_port
+
+    def get_body_poses_input_port(self):
+        return self._poses_port
+
+    def get_noise_input_port(self):
+        return self._noise_port
+
+    def get_wrench_output_port(self):
+        return self._wrench_port
+
+    def get_force_output_port(self):
+        return self._force_port
+
+    def _R_WS(self, context) -> np.ndarray:
+        X_WC = self._poses_port.Eval(context)[self._child]
+        return X_WC.rotation().matrix() @ self._R_CS
+
+    def tared_wrench(self, context) -> np.ndarray:
+        """The noise-free, undelayed tared wrench ``[tau; f]`` in S now."""
+        F_CS_S = self._reaction_port.Eval(context)[self._joint].get_coeffs()
+        return tared_sensor_wrench(
+            F_CS_S,
+            self._R_WS(context),
+            distal_mass_kg=self._distal_mass,
+            p_SScm=self._p_SScm,
+            gravity_W=self._gravity_W,
+        )
+
+    def _update(self, context, discrete_state):
+        sample = self.tared_wrench(context)
+        if self._noise_port.HasValue(context) and np.any(self._noise_std > 0):
+            sample = sample + self._noise_std * self._noise_port.Eval(context)
+        old = context.get_discrete_state(self._buffer).get_value()
+        new = np.concatenate([sample, old[: 6 * (self._n - 1)]])
+        discrete_state.set_value(self._buffer, new)
+
+    def _reading(self, context) -> np.ndarray:
+        buf = context.get_discrete_state(self._buffer).get_value()
+        return buf[6 * (self._n - 1) :] + self._bias
+
+    def _calc_wrench(self, context, output: BasicVector):
+        output.SetFromVector(self._reading(context))
+
+    def _calc_force(self, context, output: BasicVector):
+        output.SetFromVector(self._R_WS(context) @ self._reading(context)[3:])
