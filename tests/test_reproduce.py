@@ -30,7 +30,7 @@ def test_cli_unknown_stage_is_a_clean_error(tmp_path, capsys):
 def test_real_logs_claims_and_report(tmp_path, data_dir):
     result = reproduce(ReproduceOptions(
         out_dir=tmp_path, data_dir=data_dir,
-        stages=("map", "real_scans", "claims", "report")))
+        stages=("real_scans", "claims", "report")))
     claims = json.loads((tmp_path / "claims.json").read_text())
     assert list(claims) == [f"C{i}" for i in range(1, 8)]
     for c in claims.values():

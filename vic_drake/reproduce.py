@@ -223,7 +223,8 @@ def real_scan_frame(df: pd.DataFrame, *, controller: str | None = None) -> pd.Da
 
 
 def stage_real_scans(ctx: RunContext) -> dict:
-    """The paper's scan logs -> canonical frames and claim metrics."""
+    """The paper's scan logs -> canonical frames and claim metrics; ribs in the
+    paper's measured kappa map (C3 "real")."""
     if ctx.data_dir is None:
         raise StageSkipped("no real data (pass --data-dir or set VIC_DRAKE_DATA)")
     frames: dict = {"nominal": {}, "disturbance": {}}
@@ -236,7 +237,9 @@ def stage_real_scans(ctx: RunContext) -> dict:
         df = real_scan_frame(read_bag(path), controller=ctrl)
         frames[cond][ctrl] = df
         metrics[cond][ctrl] = claims_mod.scan_metrics(df, limits=REAL_LIMITS)
-    return {"frames": frames, "metrics": metrics}
+    m = read_phantom_map(ctx.data_dir / "phantom_map")
+    ribs = claims_mod.rib_prominences(m.x_m, m.y_m, m.kappa)
+    return {"frames": frames, "metrics": metrics, "ribs": ribs}
 
 
 # --- Offline estimation -------------------------------------------------------
@@ -372,25 +375,275 @@ def stage_offline_sim(ctx: RunContext) -> dict:
     return out
 
 
+#: The region the paper palpated (the measured map's extent), m.
+MAP_REGION_M = (-0.1587, 0.0423, -0.4145, -0.3125)
+
+
 def stage_map(ctx: RunContext) -> dict:
-    """Rib detection on the measured map; the estimated map when B's API exists."""
+    """Palpation campaign on a 1 cm grid, GP map of kappa and lambda, ribs.
+
+    The campaign palpates the scan phantom (the measured map when the data is
+    there, else the synthetic chest) in simulation; its GP kappa map gives C3
+    "sim". The paper's own GP map (``phantom_map/``) gives C3 "real".
+    """
+    from vic_drake.estimation.campaign import CampaignParams, run_campaign
+    from vic_drake.estimation.gp_maps import gp_map
+    from vic_drake.tissue import load_phantom
+
     out: dict = {}
+    real_map = None
     if ctx.data_dir is not None:
-        m = read_phantom_map(ctx.data_dir / "phantom_map")
-        out["ribs_real"] = claims_mod.rib_prominences(m.x_m, m.y_m, m.kappa)
-    out["ribs_sim"] = None
-    out["reason_sim"] = "vic_drake.estimation.campaign is not available yet"
+        real_map = read_phantom_map(ctx.data_dir / "phantom_map")
+    phantom = load_phantom(ctx.phantom_kind, data_dir=ctx.data_dir)
+    params = CampaignParams(spacing_m=0.01, region_m=MAP_REGION_M)
+    campaign = run_campaign(phantom, params, progress=lambda m: ctx.progress(f"  {m}"))
+    pts = campaign.ok
+    res = 0.002 if ctx.options.quick else 0.001
+    x0, x1, y0, y1 = MAP_REGION_M
+    xs = np.arange(x0, x1 + 1e-9, res)
+    ys = np.arange(y0, y1 + 1e-9, res)
+    ctx.progress(f"  GP maps of kappa and lambda on {xs.size} x {ys.size} points")
+    kappa = gp_map(pts["x_m"], pts["y_m"], pts["kappa_N_per_m_beta"], xs, ys)
+    lam = gp_map(pts["x_m"], pts["y_m"], pts["lambda_N_s_per_m_beta1"], xs, ys)
+    out["ribs_sim"] = claims_mod.rib_prominences(xs, ys, kappa.mean)
+    out["campaign"] = campaign
+    out["kappa_map"], out["lambda_map"] = kappa, lam
+    truth = phantom.sample(*np.meshgrid(xs, ys, indexing="ij"))
+    kerr = kappa.mean - truth.kappa
+    out["kappa_rel_rmse"] = float(np.sqrt(np.mean(kerr**2)) / np.mean(truth.kappa))
+    ctx.add_figure(
+        "Fig. 4: GP maps of kappa and lambda",
+        f"GP maps estimated from {len(pts)} simulated palpations on a 1 cm grid of the "
+        f"{ctx.phantom_kind} phantom (top), and the paper's measured GP map (bottom, when "
+        f"the data is there). kappa relative RMS error vs the phantom: "
+        f"{out['kappa_rel_rmse']:.1%}. Detected ribs marked.",
+        _plot_maps(kappa, lam, pts, real_map, out["ribs_sim"], out.get("ribs_real")),
+        "fig4_gp_maps.png")
+    ctx.add_figure(
+        "Fig. 5: surface with elasticity",
+        "Palpated surface heights coloured by the estimated kappa (the paper's Fig. 5 "
+        "projects the kappa map on the GRIDFIT surface).",
+        _plot_surface(pts), "fig5_surface_kappa.png")
     return out
 
 
+def _plot_maps(kappa, lam, pts, real_map, ribs_sim, ribs_real):
+    from matplotlib.figure import Figure
+
+    rows = 2 if real_map is not None else 1
+    fig = Figure(figsize=(11, 3.6 * rows))
+    axes = fig.subplots(rows, 2, squeeze=False)
+    ext = [kappa.x_m[0], kappa.x_m[-1], kappa.y_m[0], kappa.y_m[-1]]
+
+    def show(ax, grid, title, extent, ribs=None):
+        im = ax.imshow(grid.T, origin="lower", extent=extent, aspect="equal", cmap="viridis")
+        fig.colorbar(im, ax=ax, shrink=0.8)
+        ax.set_title(title, fontsize=9)
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("y [m]")
+        for xr in (ribs or {}).get("rib_position_m", []):
+            ax.axvline(xr, color="r", ls=":", lw=1)
+
+    show(axes[0, 0], kappa.mean, "kappa, estimated (sim) [N/m^beta]", ext, ribs_sim)
+    axes[0, 0].plot(pts["x_m"], pts["y_m"], "k.", ms=2)
+    show(axes[0, 1], lam.mean, "lambda, estimated (sim) [N s/m^(beta+1)]", ext)
+    if real_map is not None:
+        rext = [real_map.x_m[0], real_map.x_m[-1], real_map.y_m[0], real_map.y_m[-1]]
+        show(axes[1, 0], real_map.kappa, "kappa, paper's measured map", rext, ribs_real)
+        show(axes[1, 1], real_map.lam, "lambda, paper's measured map", rext)
+    fig.tight_layout()
+    return fig
+
+
+def _plot_surface(pts):
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(7, 5))
+    ax = fig.add_subplot(projection="3d")
+    sc = ax.scatter(pts["x_m"], pts["y_m"], pts["surface_z_m"], c=pts["kappa_N_per_m_beta"],
+                    cmap="viridis", s=12)
+    fig.colorbar(sc, ax=ax, shrink=0.6, label="kappa [N/m^beta]")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_zlabel("surface z [m]")
+    ax.view_init(elev=30, azim=60)
+    return fig
+
+
+# --- Scans --------------------------------------------------------------------
+
+
+def disturbance_lifts(t_scan_start_s: float):
+    """The phantom lifted by hand and dropped (contact loss and re-contact).
+
+    The phantom rises by 15 mm over 0.5 s, 2 s into the scan, is held 1 s and
+    drops back quickly (0.15 s), then dips 10 mm below its rest for 1 s: the
+    drop outruns the compliant probe, which loses contact and touches again.
+    """
+    from vic_drake.scenario import PhantomLift
+
+    t = t_scan_start_s + 2.0
+    return [
+        PhantomLift(start_s=t, height_m=0.015, rise_s=0.5, hold_s=1.0, fall_s=0.15),
+        PhantomLift(start_s=t + 1.65, height_m=-0.010, rise_s=0.15, hold_s=1.0, fall_s=0.5),
+    ]
+
+
+def scan_scenario(controller: str, *, disturbed: bool, phantom_kind: str, quick: bool):
+    """The scenario of one scan of the paper (nominal or disturbed).
+
+    Defaults of :class:`vic_drake.scenario.Scenario` (the real rig's scan:
+    target 0.085 m, 1 cm/s along -x, lift-off at the end) with the
+    controller's settings of the real experiments: R = 0.1 (VS-CF), 1e-5
+    (VS-VF); CS at 400 N/m with FDCC's default z gains; CF at 7 N. Quick mode
+    scans 8 cm instead of 20 cm.
+    """
+    from dataclasses import replace
+
+    from vic_drake.experiments import CS_FDCC_Z_GAINS, DEFAULT_R
+    from vic_drake.scenario import DisturbanceConfig, PhantomConfig, Scenario
+
+    base = Scenario()
+    ctrl = base.controller
+    ref = replace(ctrl.reference, controller=controller)
+    qp = ctrl.qp
+    if controller in DEFAULT_R:
+        r = DEFAULT_R[controller]
+        qp = replace(qp, r_weight=[r, r, r])
+    fdcc = base.fdcc
+    if controller == "cs":
+        from vic_drake.control.fdcc import with_force_gains
+
+        fdcc = with_force_gains(fdcc, axis=2, p=CS_FDCC_Z_GAINS[0], d=CS_FDCC_Z_GAINS[1])
+    traj = base.trajectory
+    if quick:
+        traj = replace(traj, end_x_m=traj.start_x_m - 0.08)
+    t_scan = traj.start_delay_s + (traj.approach_z_m - traj.target_z_m) / \
+        traj.approach_speed_m_per_s + traj.dwell_s
+    disturbance = DisturbanceConfig(lifts=disturbance_lifts(t_scan)) if disturbed \
+        else DisturbanceConfig()
+    cond = "disturbance" if disturbed else "nominal"
+    return replace(
+        base,
+        name=f"{controller.replace('-', '_')}_{cond}_{phantom_kind}",
+        description=f"{controller.upper()} scan, {cond}, {phantom_kind} phantom "
+        f"({'quick' if quick else 'full'} mode)",
+        phantom=PhantomConfig(kind=phantom_kind),
+        controller=replace(ctrl, reference=ref, qp=qp),
+        fdcc=fdcc,
+        trajectory=traj,
+        disturbance=disturbance,
+    )
+
+
+def scan_limits(scenario) -> claims_mod.ScanLimits:
+    """K_min, T_min, P_max, eps_d of a scenario's controller."""
+    c = scenario.controller
+    return claims_mod.ScanLimits(
+        k_min_z_N_per_m=float(c.qp.stiffness_min_N_per_m[2]),
+        tank_min_J=float(c.tank.min_energy_J),
+        power_max_W=float(-c.tank.power_limit_W),
+        eps_d_m=float(c.reference.eps_d_m),
+    )
+
+
 def stage_scans(ctx: RunContext) -> dict:
-    """Nominal and disturbance scans in simulation."""
-    raise StageSkipped("vic_drake.experiments.run_scan is not available yet")
+    """The four controllers nominal, VS-VF/CS/CF disturbed; logs; Fig. 6-7.
+
+    The nominal VS-VF run is recorded in Meshcat (when it starts) for the
+    replay.
+    """
+    from vic_drake.experiments import run_scan
+    from vic_drake.scenario import save_scenario
+    from vic_drake.tissue import load_phantom
+
+    phantom = load_phantom(ctx.phantom_kind, data_dir=ctx.data_dir)
+    runs = [("nominal", c) for c in CONTROLLERS] + \
+        [("disturbance", c) for c in DISTURBANCE_CONTROLLERS]
+    logs = ctx.out_dir / "logs"
+    logs.mkdir(parents=True, exist_ok=True)
+    frames: dict = {"nominal": {}, "disturbance": {}}
+    metrics: dict = {"nominal": {}, "disturbance": {}}
+    timing = []
+    limits = None
+    for i, (cond, ctrl) in enumerate(runs):
+        scenario = scan_scenario(ctrl, disturbed=cond == "disturbance",
+                                 phantom_kind=ctx.phantom_kind, quick=ctx.options.quick)
+        meshcat = _start_meshcat(ctx) if (cond, ctrl) == ("nominal", "vs-vf") else None
+        ctx.progress(f"  scan {i + 1}/{len(runs)}: {scenario.description}")
+        result = run_scan(scenario, phantom=phantom, meshcat=meshcat, data_dir=ctx.data_dir)
+        if meshcat is not None:
+            ctx.results["_meshcat"] = meshcat
+        df = result.df
+        df.to_parquet(logs / f"{scenario.name}.parquet", index=False)
+        save_scenario(scenario, logs / f"{scenario.name}.yaml")
+        lim = scan_limits(scenario)
+        limits = limits or lim
+        frames[cond][ctrl] = df
+        metrics[cond][ctrl] = claims_mod.scan_metrics(df, limits=lim)
+        timing.append({"run": scenario.name, "sim_s": result.sim_s, "wall_s": result.wall_s,
+                       "rtf": result.rtf})
+        ctx.progress(f"  scan {i + 1}/{len(runs)} done: {result.sim_s:.1f} s simulated in "
+                     f"{result.wall_s:.1f} s (RTF {result.rtf:.2f})")
+    _scan_figures(ctx, frames)
+    from vic_drake.report import ReportTable
+
+    ctx.tables.append(ReportTable("Simulated scans: timing", ["run", "simulated [s]",
+                                                              "wall [s]", "RTF"],
+                                  [[t["run"], t["sim_s"], t["wall_s"], t["rtf"]]
+                                   for t in timing]))
+    return {"frames": frames, "metrics": metrics, "limits": limits, "timing": timing}
+
+
+def _scan_figures(ctx: RunContext, frames: dict) -> None:
+    from vic_drake.plots.scans import plot_fig6, plot_fig7
+
+    real = (ctx.results.get("real_scans") or {}).get("frames", {})
+    nominal = {k: frames["nominal"][k] for k in ("vs-cf", "vs-vf") if k in frames["nominal"]}
+    if nominal:
+        ctx.add_figure("Fig. 6: VS-CF and VS-VF, nominal",
+                       "Simulated scans (and the real logs where they exist): force with "
+                       "F_ref and F_min, K_z, penetration, tank energy.",
+                       plot_fig6(nominal, real.get("nominal")), "fig6_nominal.png")
+    base = {k: frames["nominal"][k] for k in ("cs", "cf") if k in frames["nominal"]}
+    if base:
+        ctx.add_figure("CS and CF, nominal (not in the paper's Fig. 6)",
+                       "The baselines' nominal scans, same layout as Fig. 6.",
+                       plot_fig6(base, real.get("nominal")), "fig6_baselines.png")
+    dist = {k: frames["disturbance"][k] for k in DISTURBANCE_CONTROLLERS
+            if k in frames["disturbance"]}
+    if dist:
+        ctx.add_figure("Fig. 7: VS-VF, CS, CF with the phantom lifted",
+                       "Phantom lifted and dropped during the scan: force, tip height with "
+                       "the moving surface, K_z (real _dist logs of CS and CF overlaid).",
+                       plot_fig7(dist, real.get("disturbance")), "fig7_disturbance.png")
+
+
+def _start_meshcat(ctx: RunContext):
+    """A Meshcat recording (None if Meshcat cannot start here)."""
+    if ctx.options.stages is not None and "replay" not in ctx.options.stages:
+        return None
+    try:
+        from pydrake.geometry import Meshcat
+
+        meshcat = Meshcat()
+        meshcat.StartRecording(frames_per_second=32.0)
+        return meshcat
+    except Exception as exc:  # noqa: BLE001 - the replay is optional
+        ctx.progress(f"  Meshcat unavailable ({exc}); no replay")
+        return None
 
 
 def stage_replay(ctx: RunContext) -> dict:
-    """A Meshcat replay of one scan, as a standalone HTML file."""
-    raise StageSkipped("vic_drake.experiments.MakeScanDiagram is not available yet")
+    """The Meshcat recording of the nominal VS-VF scan as a standalone HTML file."""
+    meshcat = ctx.results.pop("_meshcat", None)
+    if meshcat is None:
+        raise StageSkipped("no Meshcat recording (the scans stage did not record one)")
+    meshcat.StopRecording()
+    meshcat.PublishRecording()
+    path = ctx.out_dir / "replay.html"
+    path.write_text(meshcat.StaticHtml(), encoding="utf-8")
+    return {"path": path, "bytes": path.stat().st_size}
 
 
 # --- Claims and report --------------------------------------------------------
@@ -417,12 +670,9 @@ def gather_claim_inputs(ctx: RunContext) -> claims_mod.ClaimInputs:
         inp.decay_sim = off_sim.get("decay")
     mp = r.get("map")
     if mp:
-        inp.ribs_real = mp.get("ribs_real")
         inp.ribs_sim = mp.get("ribs_sim")
-        reasons["C3.sim"] = mp.get("reason_sim") or reason("map")
-        reasons["C3.real"] = "no real data" if ctx.data_dir is None else reason("map")
-    else:
-        reasons["C3.sim"] = reasons["C3.real"] = reason("map")
+    reasons["C3.sim"] = reason("map")
+    reasons["C3.real"] = reason("real_scans")
     scans = r.get("scans")
     if scans:
         inp.nominal_sim = scans["metrics"].get("nominal")
@@ -434,6 +684,7 @@ def gather_claim_inputs(ctx: RunContext) -> claims_mod.ClaimInputs:
         reasons[f"{cid}.real"] = reason("real_scans")
     rs = r.get("real_scans")
     if rs:
+        inp.ribs_real = rs.get("ribs")
         inp.nominal_real = rs["metrics"].get("nominal")
         inp.disturbance_real = rs["metrics"].get("disturbance")
         reasons["C7.real"] = "the published data has no VS-VF disturbance log"
@@ -547,8 +798,8 @@ STAGES: tuple[tuple[str, Callable[[RunContext], Any]], ...] = (
     ("offline_real", stage_offline_real),
     ("offline_sim", stage_offline_sim),
     ("map", stage_map),
-    ("scans", stage_scans),
     ("real_scans", stage_real_scans),
+    ("scans", stage_scans),
     ("replay", stage_replay),
     ("claims", stage_claims),
     ("report", stage_report),
