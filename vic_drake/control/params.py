@@ -11,9 +11,10 @@ Validation therefore runs twice: in ``__post_init__`` (direct construction)
 and in :meth:`validate`, which every builder (``MakeVariableImpedanceController``,
 the LeafSystems, the replay) calls again on what it is given, so values
 loaded from YAML are checked too. Every message names the field and the value.
-"""
 
-from __future__ import annotations
+(No ``from __future__ import annotations`` here: Drake's YAML loader reads
+the field types at run time.)
+"""
 
 import math
 from dataclasses import dataclass, field
@@ -85,7 +86,7 @@ class TankParams:
     def __post_init__(self):
         self.validate()
 
-    def validate(self) -> TankParams:
+    def validate(self) -> "TankParams":
         o = "TankParams"
         t_min = _positive(o, "min_energy_J", self.min_energy_J)
         t_max = _finite(o, "max_energy_J", self.max_energy_J)
@@ -151,7 +152,7 @@ class StiffnessQpParams:
     def __post_init__(self):
         self.validate()
 
-    def validate(self) -> StiffnessQpParams:
+    def validate(self) -> "StiffnessQpParams":
         o = "StiffnessQpParams"
         for name in ("q_weight", "r_weight"):
             for i, v in enumerate(_vec3(o, name, getattr(self, name))):
@@ -244,7 +245,7 @@ class ReferenceParams:
     def __post_init__(self):
         self.validate()
 
-    def validate(self) -> ReferenceParams:
+    def validate(self) -> "ReferenceParams":
         o = "ReferenceParams"
         if self.controller not in CONTROLLERS:
             raise VicDrakeError(
@@ -301,7 +302,7 @@ class ControllerParams:
     def __post_init__(self):
         self.validate()
 
-    def validate(self) -> ControllerParams:
+    def validate(self) -> "ControllerParams":
         _positive("ControllerParams", "period_s", self.period_s)
         for name, kind in (
             ("tank", TankParams),
