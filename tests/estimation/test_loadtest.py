@@ -82,3 +82,17 @@ def test_hunt_crossley_predicts_real_load_tests_better(data_dir, soft_1hz, name)
     # KV under-predicts the held 15 mm load (the paper's Fig. 2 limitation).
     hold = (result.t_s > 8.0) & (result.t_s < 10.5)
     assert np.mean(result.kelvin_voigt_N[hold]) < np.mean(result.measured_N[hold]) - 1.0
+
+
+def test_load_test_figure(tmp_path):
+    from vic_drake.plots.offline import plot_load_test
+
+    result = load_test(synthetic_load_test(), synthetic_palpation(), lag_s=0.0)
+    fig = plot_load_test(result, save_path=tmp_path / "fig2.png")
+    labels = [line.get_label() for line in fig.axes[0].get_lines()]
+    assert (
+        labels[0] == "measured"
+        and "Kelvin-Voigt" in labels[1]
+        and "Hunt-Crossley" in labels[2]
+    )
+    assert (tmp_path / "fig2.png").stat().st_size > 10_000

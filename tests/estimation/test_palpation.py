@@ -313,3 +313,39 @@ def test_table_i_ordering_on_soft_1hz(real_comparisons):
         < hc[1.1].relative
         < c.kelvin_voigt.relative
     )
+
+
+def test_exponential_fit_is_robust_to_one_outlier():
+    t = np.linspace(0.5, 30.0, 40)
+    r = 0.1 * np.exp(-t / 4.0) + 0.02
+    r[1] = 0.0  # One window that happened to generalise unusually well.
+    fit = fit_exponential(t, r)
+    assert fit.tau_s == pytest.approx(4.0, rel=0.1)
+    assert fit.c == pytest.approx(0.02, rel=0.05)
+
+
+def test_offline_figures(tmp_path):
+    from matplotlib.figure import Figure
+
+    from vic_drake.plots.offline import (
+        plot_beta_sweep,
+        plot_palpation_summary,
+        plot_residual_vs_time,
+        plot_table_i,
+    )
+
+    data = synthetic_palpation(lag_s=0.02, noise_N=0.05, duration_s=8.0)
+    comparison = compare_models(data)
+    curve = residual_vs_palpation_time(shift(data, comparison.lag_s))
+    figures = [
+        plot_table_i({"synthetic": comparison, "again": comparison}),
+        plot_beta_sweep(comparison.sweep),
+        plot_residual_vs_time({"synthetic": curve}),
+        plot_palpation_summary(
+            comparison, title="synthetic", save_path=tmp_path / "s.png"
+        ),
+    ]
+    assert all(isinstance(f, Figure) for f in figures)
+    # Bars: 4 models x 2 logs.
+    assert len(figures[0].axes[0].patches) == 8
+    assert (tmp_path / "s.png").stat().st_size > 10_000

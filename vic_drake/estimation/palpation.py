@@ -57,7 +57,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.ndimage import median_filter
-from scipy.optimize import curve_fit, minimize_scalar
+from scipy.optimize import minimize_scalar
 
 from vic_drake.errors import VicDrakeError
 from vic_drake.estimation.signals import (
@@ -898,26 +898,53 @@ class ResidualCurve:
     beta: float
 
 
-def fit_exponential(t_s, r) -> ExponentialFit | None:
-    """Least-squares r(t) = a exp(-t/tau) + c; None if it does not converge."""
+def fit_exponential(t_s, r, *, min_tau_s: float | None = None) -> ExponentialFit | None:
+    """Robust least squares of r(t) = a exp(-t/tau) + c.
+
+    Soft-L1 loss (scale: a tenth of the spread of r), so a few windows that
+    happen to generalise unusually well or badly (e.g. one holding only the
+    approach transient) do not bend the curve; tau is bounded below by
+    ``min_tau_s`` (default: the smallest t, since a decay faster than the
+    first sample is not resolved by the data).
+
+    Returns:
+        The fit, or None with fewer than 4 points or no convergence.
+    """
+    from scipy.optimize import least_squares
+
     t_s = np.asarray(t_s, float)
     r = np.asarray(r, float)
-    if t_s.size < 4:
+    if t_s.size < 4 or not np.all(np.isfinite(r)):
         return None
-    c0 = float(r[-1])
-    a0 = float(max(r[0] - c0, 1e-12))
-    tau0 = float(max((t_s[-1] - t_s[0]) / 5.0, 1e-3))
-    try:
-        (a, tau, c), _ = curve_fit(
-            lambda t, a, tau, c: a * np.exp(-t / tau) + c,
-            t_s,
-            r,
-            p0=(a0, tau0, c0),
-            bounds=([-np.inf, 1e-6, -np.inf], [np.inf, np.inf, np.inf]),
-            maxfev=20000,
-        )
-    except (RuntimeError, ValueError):
+    min_tau = float(t_s.min() if min_tau_s is None else min_tau_s)
+    min_tau = max(min_tau, 1e-6)
+    order = np.argsort(t_s)
+    quarter = max(t_s.size // 4, 1)
+    c0 = float(np.median(r[order[-quarter:]]))
+    a0 = float(np.median(r[order[:quarter]]) - c0)
+    if a0 == 0.0:
+        a0 = 1e-12
+    tau0 = float(max((t_s.max() - t_s.min()) / 5.0, min_tau * 1.01))
+    spread = float(np.ptp(r))
+    if spread == 0.0:
+        return ExponentialFit(a=0.0, tau_s=tau0, c=float(r[0]))
+
+    def resid(x):
+        a, tau, c = x
+        return a * np.exp(-t_s / tau) + c - r
+
+    res = least_squares(
+        resid,
+        x0=(a0, tau0, c0),
+        bounds=([-np.inf, min_tau, -np.inf], [np.inf, np.inf, np.inf]),
+        loss="soft_l1",
+        f_scale=0.1 * spread,
+        x_scale=(max(abs(a0), 1e-12), tau0, max(abs(c0), 1e-12)),
+        max_nfev=20000,
+    )
+    if not res.success:
         return None
+    a, tau, c = res.x
     return ExponentialFit(a=float(a), tau_s=float(tau), c=float(c))
 
 
