@@ -1,0 +1,251 @@
+"""The controller Diagram and its LeafSystems: ports, one tick, faults, parameters."""
+
+import math
+
+import numpy as np
+import pytest
+from pydrake.systems.analysis import Simulator
+
+from vic_drake.control.params import (
+    ControllerParams,
+    ReferenceParams,
+    StiffnessQpParams,
+)
+from vic_drake.control.stiffness_qp import (
+    make_stiffness_qp_problem,
+    solve_stiffness_qp_exact,
+)
+from vic_drake.control.tank import tank_step
+from vic_drake.errors import VicDrakeError
+from vic_drake.systems.controller import MakeVariableImpedanceController
+from vic_drake.systems.references import ForceReferenceSystem
+from vic_drake.systems.stiffness_qp import StiffnessQpSystem
+from vic_drake.systems.tank import EnergyTankSystem
+from vic_drake.tissue.phantom import GridPhantom
+
+KAPPA, LAM, BETA, SURFACE_Z = 5000.0, 40000.0, 1.35, 0.10
+
+
+@pytest.fixture(scope="module")
+def phantom():
+    """Flat tissue at z = 0.10 m with uniform kappa, lambda."""
+    x = np.array([-1.0, 1.0])
+    ones = np.ones((2, 2))
+    return GridPhantom(
+        x_m=x,
+        y_m=x,
+        z_m=SURFACE_Z * ones,
+        kappa=KAPPA * ones,
+        lam=LAM * ones,
+        beta=BETA,
+    )
+
+
+P_WP = np.array([0.01, -0.36, 0.095])  # 5 mm inside the tissue.
+V_WP = np.array([-0.01, 0.0, 0.004])
+X_D = np.array([0.0, -0.36, 0.085])
+F_W = np.array([1.0, -0.5, -6.0])
+
+
+def make(phantom, controller="vs-cf", **kw):
+    params = ControllerParams(reference=ReferenceParams(controller=controller), **kw)
+    diagram = MakeVariableImpedanceController(params, phantom=phantom)
+    context = diagram.CreateDefaultContext()
+    for name, value in (("ee_position", P_WP), ("ee_velocity", V_WP), ("target_position", X_D),
+                        ("measured_force", F_W)):  # fmt: skip
+        diagram.GetInputPort(name).FixValue(context, value)
+    return params, diagram, context
+
+
+def tick(diagram, context, n=1):
+    for _ in range(n):
+        context.SetDiscreteState(diagram.EvalUniquePeriodicDiscreteUpdate(context))
+
+
+def out(diagram, context, name):
+    return diagram.GetOutputPort(name).Eval(context)
+
+
+def test_ports_match_the_interface(phantom):
+    _, diagram, _ = make(phantom)
+    assert diagram.get_name() == "variable_impedance_controller"
+    inputs = {diagram.get_input_port(i).get_name(): diagram.get_input_port(i).size()
+              for i in range(diagram.num_input_ports())}  # fmt: skip
+    outputs = {diagram.get_output_port(i).get_name(): diagram.get_output_port(i).size()
+               for i in range(diagram.num_output_ports())}  # fmt: skip
+    assert inputs == {
+        "ee_position": 3,
+        "ee_velocity": 3,
+        "target_position": 3,
+        "measured_force": 3,
+    }
+    assert outputs == {"stiffness": 3, "damping": 3, "target_force": 3, "force_reference": 3,
+                       "force_min": 3, "tank": 4, "status": 6}  # fmt: skip
+
+
+def test_one_tick_equals_the_pure_functions(phantom):
+    params, diagram, context = make(phantom, "vs-cf")
+    k0 = tuple(params.qp.stiffness_min_N_per_m)
+    np.testing.assert_array_equal(out(diagram, context, "stiffness"), k0)
+    tick(diagram, context)
+    # Independent computation of the same tick.
+    e = tuple(X_D - P_WP)
+    e_dot = tuple(-V_WP)
+    d0 = tuple(2 * 0.707 * math.sqrt(k) for k in k0)
+    eps_dot = 0.0 - V_WP[2]  # Flat surface: first filter tick gives rate 0.
+    f_min_z = -(KAPPA + LAM * eps_dot) * 0.008**BETA
+    problem = make_stiffness_qp_problem(e, e_dot, d0, (0, 0, -7.0), (-15, -15, f_min_z), 0.5, 0.002,
+                                        params.qp, params.tank)  # fmt: skip
+    expected = solve_stiffness_qp_exact(problem)
+    assert expected.success
+    np.testing.assert_allclose(
+        out(diagram, context, "stiffness"), expected.stiffness, rtol=0, atol=1e-12
+    )
+    np.testing.assert_allclose(out(diagram, context, "damping"),
+                               2 * 0.707 * np.sqrt(expected.stiffness), rtol=1e-14)  # fmt: skip
+    np.testing.assert_allclose(
+        out(diagram, context, "force_min"), (-15, -15, f_min_z), rtol=1e-14
+    )
+    np.testing.assert_array_equal(
+        out(diagram, context, "force_reference"), (0, 0, -7.0)
+    )
+    np.testing.assert_array_equal(out(diagram, context, "target_force"), (0, 0, 0))
+    step = tank_step(0.5, e, e_dot, expected.stiffness, k0, d0, 0.002, params.tank)
+    np.testing.assert_allclose(out(diagram, context, "tank"), [step.energy_J, step.power_W, 1.0, 1.0],
+                               rtol=1e-14)  # fmt: skip
+    qp_ok, count, fault, contact, solve_time, pen = out(diagram, context, "status")
+    assert (qp_ok, count, fault, contact) == (1.0, 0.0, 0.0, 1.0)
+    assert solve_time > 0.0 and pen == pytest.approx(SURFACE_Z - P_WP[2])
+
+
+def test_tank_and_qp_stay_in_step_over_many_ticks(phantom):
+    """No one-tick lag: the QP sees T after the previous tick, the tank applies this tick's K."""
+    params, diagram, context = make(phantom, "vs-vf")
+    energy, k_prev = 0.5, tuple(params.qp.stiffness_min_N_per_m)
+    k_min = k_prev
+    for _ in range(5):
+        tick(diagram, context)
+        d = tuple(2 * 0.707 * math.sqrt(k) for k in k_prev)
+        f_ref = out(diagram, context, "force_reference")
+        f_min = out(diagram, context, "force_min")
+        p = make_stiffness_qp_problem(tuple(X_D - P_WP), tuple(-V_WP), d, f_ref, f_min, energy, 0.002,
+                                      params.qp, params.tank)  # fmt: skip
+        k = solve_stiffness_qp_exact(p).stiffness
+        energy = tank_step(
+            energy, tuple(X_D - P_WP), tuple(-V_WP), k, k_min, d, 0.002, params.tank
+        ).energy_J
+        np.testing.assert_allclose(
+            out(diagram, context, "stiffness"), k, atol=1e-12, rtol=0
+        )
+        assert out(diagram, context, "tank")[0] == pytest.approx(energy, rel=1e-14)
+        k_prev = k
+
+
+@pytest.mark.parametrize(
+    "port", ["ee_position", "ee_velocity", "target_position", "measured_force"]
+)
+@pytest.mark.parametrize("bad", [math.nan, math.inf])
+def test_non_finite_measurement_gives_k_min_and_fault(phantom, port, bad):
+    params, diagram, context = make(phantom, "vs-vf")
+    tick(diagram, context, 3)
+    value = {
+        "ee_position": P_WP,
+        "ee_velocity": V_WP,
+        "target_position": X_D,
+        "measured_force": F_W,
+    }[port].copy()
+    value[2] = bad
+    diagram.GetInputPort(port).FixValue(context, value)
+    tick(diagram, context, 2)
+    np.testing.assert_array_equal(
+        out(diagram, context, "stiffness"), params.qp.stiffness_min_N_per_m
+    )
+    status = out(diagram, context, "status")
+    assert status[0] == 0.0 and status[1] == 2.0 and status[2] == 1.0
+    for i in range(diagram.num_output_ports()):
+        assert np.all(np.isfinite(diagram.get_output_port(i).Eval(context))), (
+            diagram.get_output_port(i).get_name()
+        )
+    diagram.GetInputPort(port).FixValue(context, {"ee_position": P_WP, "ee_velocity": V_WP,
+                                                  "target_position": X_D, "measured_force": F_W}[port])  # fmt: skip
+    tick(diagram, context)
+    assert out(diagram, context, "status")[2] == 0.0  # Recovers; the count stays.
+    assert out(diagram, context, "status")[1] == 2.0
+
+
+def test_cs_and_cf(phantom):
+    params, diagram, context = make(phantom, "cs")
+    tick(diagram, context, 3)
+    np.testing.assert_array_equal(out(diagram, context, "stiffness"), [400.0] * 3)
+    np.testing.assert_array_equal(out(diagram, context, "target_force"), [0.0] * 3)
+    np.testing.assert_array_equal(out(diagram, context, "tank"), [0.5, 0.0, 0.0, 0.0])
+    params, diagram, context = make(phantom, "cf")
+    tick(diagram, context, 3)
+    np.testing.assert_array_equal(
+        out(diagram, context, "stiffness"), [400.0, 400.0, 0.0]
+    )
+    np.testing.assert_array_equal(out(diagram, context, "damping")[2], 0.0)
+    np.testing.assert_array_equal(
+        out(diagram, context, "target_force"), [0.0, 0.0, -7.0]
+    )
+    assert out(diagram, context, "status")[0] == 1.0
+
+
+def test_osqp_system_matches_exact_system(phantom):
+    _, exact, c1 = make(phantom, "vs-vf")
+    _, osqp, c2 = make(phantom, "vs-vf", qp=StiffnessQpParams(solver="osqp"))
+    tick(exact, c1, 4)
+    tick(osqp, c2, 4)
+    np.testing.assert_allclose(
+        out(osqp, c2, "stiffness"), out(exact, c1, "stiffness"), atol=1e-6, rtol=0
+    )
+
+
+def test_simulator_runs_the_periodic_events(phantom):
+    params, diagram, context = make(phantom, "vs-vf")
+    simulator = Simulator(diagram, context)
+    simulator.AdvanceTo(0.1)
+    tank = out(diagram, context, "tank")
+    assert tank[0] != 0.5  # 51 ticks of nonzero power changed the tank.
+    assert np.all(np.isfinite(tank))
+
+
+def _mutated(path, value):
+    params = ControllerParams()
+    owner = params
+    *head, last = path.split(".")
+    for name in head:
+        owner = getattr(owner, name)
+    setattr(owner, last, value)  # As yaml_load_typed does after __init__.
+    return params
+
+
+@pytest.mark.parametrize(
+    "path, value, shown",
+    [
+        ("period_s", 0.0, "0.0"),
+        ("period_s", -0.002, "-0.002"),
+        ("period_s", math.nan, "nan"),
+        ("tank.min_energy_J", 0.0, "0.0"),
+        ("tank.power_limit_W", 0.05, "0.05"),
+        ("tank.power_limit_W", 0.0, "0.0"),
+        ("qp.r_weight", [0.1, math.nan, 0.1], "nan"),
+        ("reference.controller", "impedance", "impedance"),
+    ],
+)
+def test_invalid_parameters_fail_at_construction(phantom, path, value, shown):
+    params = _mutated(path, value)
+    with pytest.raises(VicDrakeError) as info:
+        MakeVariableImpedanceController(params, phantom=phantom)
+    message = str(info.value)
+    assert path.split(".")[-1] in message and shown in message
+
+
+def test_values_mutated_after_construction_are_checked(phantom):
+    params = ControllerParams()
+    params.qp.stiffness_min_N_per_m = [300.0, 300.0, 2000.0]  # As YAML loading would.
+    for build in (lambda: MakeVariableImpedanceController(params, phantom=phantom),
+                  lambda: StiffnessQpSystem(params), lambda: EnergyTankSystem(params),
+                  lambda: ForceReferenceSystem(params, phantom=phantom)):  # fmt: skip
+        with pytest.raises(VicDrakeError, match=r"stiffness_min_N_per_m\[2\] = 2000.0"):
+            build()
