@@ -375,7 +375,7 @@ def compare_with_real(
 
     Returns:
         dict with force_rmse_N (sensor z force, sim vs real), force_peak_err_N
-        (|peak pressing force sim - real| over the whole runs), z_rmse_mm,
+        (|peak pressing force sim - real| over their common time span), z_rmse_mm,
         kz_corr (Pearson correlation of K_z over the window; None when the
         real log has no K_z or either record is constant), time_offset_s,
         window_s (start, end), force_peak_sim_N, force_peak_real_N,
@@ -408,7 +408,13 @@ def compare_with_real(
     ok = np.isfinite(k_real) & np.isfinite(k_sim)
     if ok.sum() > 10 and np.std(k_real[ok]) > 0 and np.std(k_sim[ok]) > 0:
         kz_corr = float(np.corrcoef(k_real[ok], k_sim[ok])[0, 1])
-    peak_sim, peak_real = peak_force_N(sim), peak_force_N(real)
+    # Peaks over the common time span (a shortened simulation is not charged
+    # with the peaks of the log it did not reach).
+    t_lo = max(float(sim_s["t_s"].iloc[0]), float(t[0]))
+    t_hi = min(float(sim_s["t_s"].iloc[-1]), float(t[-1]))
+    in_sim = (sim_s["t_s"] >= t_lo) & (sim_s["t_s"] <= t_hi)
+    in_real = (real["t_s"] >= t_lo) & (real["t_s"] <= t_hi)
+    peak_sim, peak_real = peak_force_N(sim_s[in_sim]), peak_force_N(real[in_real])
     tank_real = tank_min_J(real)
     return {
         "force_rmse_N": float(np.sqrt(np.mean(f_err**2))),

@@ -1,0 +1,101 @@
+"""The closed-loop scan diagram: wiring, a short run, and the real-log scenarios."""
+
+import numpy as np
+import pytest
+
+from vic_drake.errors import VicDrakeError
+from vic_drake.experiments import (
+    LOG_GROUPS,
+    MakeScanDiagram,
+    detect_controller,
+    fit_target_profile,
+    run_scan,
+    scenario_from_real_log,
+    synthetic_scenario,
+)
+from vic_drake.metrics import CANONICAL_COLUMNS
+
+
+def test_scan_diagram_is_wired_and_logs_every_group():
+    diagram, loggers = MakeScanDiagram(synthetic_scenario("vs-vf"))
+    assert diagram.get_name() == "scan"
+    assert set(loggers) == {name for name, *_ in LOG_GROUPS}
+    # Closed loop: no input port is left open.
+    assert diagram.num_input_ports() == 0
+    for name in (
+        "station",
+        "variable_impedance_controller",
+        "fdcc",
+        "target",
+        "phantom_lift",
+    ):
+        diagram.GetSubsystemByName(name)
+
+
+def test_short_run_returns_the_canonical_frame():
+    scenario = synthetic_scenario("vs-vf")
+    result = run_scan(scenario, duration_s=0.2)
+    df = result.df
+    assert tuple(df.columns) == CANONICAL_COLUMNS
+    assert df["t_s"].iloc[-1] == pytest.approx(0.2, abs=2.5e-3)
+    assert np.all(
+        np.isfinite(df[["x_m", "z_m", "force_sensor_z_N", "stiffness_z_N_per_m"]])
+    )
+    # The probe starts at rest where the IK put it: at the target, above the surface.
+    np.testing.assert_allclose(df[["x_m", "y_m"]].iloc[0], [0.036, -0.36], atol=1e-3)
+    assert df["z_m"].iloc[0] == pytest.approx(0.12, abs=1e-3)
+    assert df["penetration_m"].iloc[0] < 0  # Not touching yet.
+    assert result.rtf > 0 and result.wall_s > 0
+
+
+def test_run_scan_rejects_bad_input():
+    with pytest.raises(VicDrakeError, match="duration_s"):
+        run_scan(synthetic_scenario("cs"), duration_s=-1.0)
+    with pytest.raises(VicDrakeError, match="Scenario"):
+        MakeScanDiagram({"name": "not a scenario"})
+    with pytest.raises(VicDrakeError, match="controller"):
+        synthetic_scenario("pid")
+
+
+@pytest.mark.realdata
+def test_real_log_scenarios(data_dir):
+    from vic_drake.realdata import read_bag
+
+    exp = data_dir / "experiments"
+    vf = read_bag(exp / "test_nardi_matForce_lowR")
+    cf = read_bag(exp / "test_tracking5")
+    assert detect_controller(vf) == "vs-vf" and detect_controller(cf) == "vs-cf"
+    s = scenario_from_real_log(vf, name="vf")
+    assert s.controller.reference.controller == "vs-vf"
+    assert s.controller.qp.r_weight == [1e-5] * 3
+    assert s.phantom.kind == "measured" and s.trajectory.waypoints
+    assert s.controller.tank.initial_energy_J == pytest.approx(0.5, abs=0.01)
+    s = scenario_from_real_log(cf, name="cf", r_weight=0.5)
+    assert s.controller.reference.force_ref_N == pytest.approx(7.0)
+    assert s.controller.qp.r_weight == [0.5] * 3
+    profile = fit_target_profile(cf)
+    assert profile.scan_speed_m_per_s == pytest.approx(0.01, rel=1e-3)
+    assert profile.target_z_m == pytest.approx(0.085, abs=1e-4)
+    cs = read_bag(exp / "test_compliance_control400")
+    s = scenario_from_real_log(cs, name="test_compliance_control400")
+    assert s.controller.reference.controller == "cs"
+    assert s.controller.reference.constant_stiffness_N_per_m == [400.0] * 3
+    assert (
+        s.trajectory.scan_speed_m_per_s == 0.01 and s.trajectory.liftoff_height_m == 0
+    )
+    with pytest.raises(VicDrakeError, match="--controller"):
+        scenario_from_real_log(cs, name="mystery_log")
+    with pytest.raises(VicDrakeError, match="cs or cf"):
+        scenario_from_real_log(cs, name="x", controller="vs-vf")
+
+
+@pytest.mark.slow
+def test_full_vs_vf_nominal_scan_tracks_and_lifts_off():
+    """The whole synthetic VS-VF scan (~24 s simulated)."""
+    from vic_drake import metrics
+
+    result = run_scan(synthetic_scenario("vs-vf"))
+    df = result.df
+    assert metrics.lifted_off(df)
+    assert metrics.tank_min_J(df) >= 0.4 - 1e-6
+    assert metrics.peak_force_N(df) < 15.0

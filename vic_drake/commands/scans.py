@@ -1,0 +1,184 @@
+"""``vic-drake scan`` and ``vic-drake compare-real``: closed-loop scans.
+
+- ``scan SCENARIO.yaml``: simulates a scenario file (``diagrams/*.yaml``)
+  and prints its scan metrics; ``--out`` stores the log (parquet or csv) and
+  the exact scenario beside it.
+- ``compare-real BAG_DIR``: builds the scenario of a real scan log on the
+  measured map, simulates it, aligns it with the log and prints the
+  comparison (see :func:`vic_drake.experiments.compare_real`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+
+from vic_drake.commands.common import (
+    Progress,
+    add_data_dir_option,
+    add_json_option,
+    emit,
+)
+from vic_drake.errors import VicDrakeError
+
+#: The keys compare-real always prints (its contract), in order.
+COMPARE_KEYS = (
+    "controller",
+    "duration_s",
+    "force_rmse_N",
+    "force_peak_err_N",
+    "z_rmse_mm",
+    "kz_corr",
+    "tank_min_J",
+    "rtf",
+)
+
+
+def _positive(value: str, option: str) -> float:
+    try:
+        v = float(value)
+    except ValueError:
+        raise VicDrakeError(f"{option} takes a number > 0; got {value!r}") from None
+    if not (math.isfinite(v) and v > 0):
+        raise VicDrakeError(f"{option} takes a number > 0; got {value!r}")
+    return v
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser(
+        "compare-real",
+        help="simulate a real scan experiment on the measured map and compare with its log",
+        description=(
+            "31-column logs (VS controllers): controller and references from the log "
+            "(VS-CF if F_ref is constant, VS-VF if it varies or F_min reaches -9 N), R "
+            "from --R or 0.1 (VS-CF) / 1e-5 (VS-VF), the logged target as reference. "
+            "9-column logs (CS/CF): --controller (guessed from the folder name "
+            "*compliance_control<K>* / *force_control* otherwise), CS at --stiffness "
+            "(default 400 N/m), CF at --force (default 7 N), the target at the logged "
+            "z_target moving along -x at 1 cm/s from the logged start. *_dist logs: the "
+            "phantom lift is estimated from the log and replayed, and contact losses "
+            "are compared. The simulated record is shifted by up to 0.5 s to maximise "
+            "the force cross-correlation, then compared over the real log's contact "
+            "window (first contact + 1 s to last contact)."
+        ),
+    )
+    p.add_argument("bag_dir", metavar="BAG_DIR", help="ROS 2 bag folder of a scan")
+    p.add_argument(
+        "--controller",
+        choices=("cs", "cf", "vs-cf", "vs-vf"),
+        default=None,
+        help="controller to simulate (default: from the log)",
+    )
+    p.add_argument(
+        "--stiffness", metavar="N_PER_M", default=None, help="CS stiffness, N/m"
+    )
+    p.add_argument(
+        "--force", metavar="N", default=None, help="CF / VS-CF force reference, N"
+    )
+    p.add_argument(
+        "--R", dest="r_weight", metavar="R", default=None, help="QP weight R (> 0)"
+    )
+    p.add_argument(
+        "--duration",
+        metavar="S",
+        default=None,
+        help="simulate only the first S seconds",
+    )
+    p.add_argument(
+        "--plot", metavar="PNG", default=None, help="save a sim-vs-real figure"
+    )
+    add_data_dir_option(p)
+    add_json_option(p)
+    p.set_defaults(handler=run_compare_real)
+
+    s = subparsers.add_parser(
+        "scan",
+        help="simulate a scenario YAML (diagrams/*.yaml) and print its scan metrics",
+    )
+    s.add_argument("scenario", metavar="SCENARIO.yaml")
+    s.add_argument("--duration", metavar="S", default=None, help="simulated time, s")
+    s.add_argument(
+        "--out", metavar="FILE", default=None, help="save the log (.parquet or .csv)"
+    )
+    add_data_dir_option(s)
+    add_json_option(s)
+    s.set_defaults(handler=run_scan_command)
+
+
+def run_compare_real(args: argparse.Namespace) -> int:
+    from vic_drake.experiments import compare_real
+
+    stiffness = (
+        None if args.stiffness is None else _positive(args.stiffness, "--stiffness")
+    )
+    force = None if args.force is None else _positive(args.force, "--force")
+    r = None if args.r_weight is None else _positive(args.r_weight, "--R")
+    duration = None if args.duration is None else _positive(args.duration, "--duration")
+    progress = Progress(True)
+    out, sim, real = compare_real(
+        args.bag_dir,
+        controller=args.controller,
+        stiffness_N_per_m=stiffness,
+        force_N=force,
+        r_weight=r,
+        data_dir=args.data_dir,
+        duration_s=duration,
+        progress=progress,
+        return_frames=True,
+    )
+    if args.plot:
+        from vic_drake.plots.scans import plot_comparison
+
+        plot_comparison(sim, real, title=Path(args.bag_dir).name, save_path=args.plot)
+    ordered = {k: out.get(k) for k in COMPARE_KEYS}
+    ordered.update({k: v for k, v in out.items() if k not in ordered})
+    kz = "n/a" if ordered["kz_corr"] is None else f"{ordered['kz_corr']:.3f}"
+    human = (
+        f"{Path(args.bag_dir).name} ({ordered['controller']}, {ordered['duration_s']:.1f} s, "
+        f"RTF {ordered['rtf']:.2f}): force RMSE {ordered['force_rmse_N']:.3f} N, "
+        f"peak error {ordered['force_peak_err_N']:.3f} N, z RMSE {ordered['z_rmse_mm']:.2f} mm, "
+        f"K_z corr {kz}"
+    )
+    emit(ordered, args.json, human)
+    return 0
+
+
+def run_scan_command(args: argparse.Namespace) -> int:
+    from vic_drake import metrics
+    from vic_drake.experiments import run_scan
+    from vic_drake.scenario import load_scenario, save_scenario
+
+    scenario = load_scenario(args.scenario)
+    duration = None if args.duration is None else _positive(args.duration, "--duration")
+    result = run_scan(
+        scenario, duration_s=duration, data_dir=args.data_dir, progress=Progress(True)
+    )
+    df = result.df
+    out = {
+        "scenario": scenario.name,
+        "controller": scenario.controller.reference.controller,
+        "duration_s": result.sim_s,
+        "rtf": result.rtf,
+        "force_rmse_N": metrics.force_rmse_N(df),
+        "force_range_N": list(metrics.force_range_N(df)),
+        "force_peak_N": metrics.peak_force_N(df),
+        "tank_min_J": metrics.tank_min_J(df),
+        "contact_loss_s": [list(i) for i in metrics.contact_loss_intervals(df)],
+        "lifted_off": metrics.lifted_off(df),
+    }
+    if args.out:
+        path = Path(args.out)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        if path.suffix == ".csv":
+            df.to_csv(path, index=False)
+        elif path.suffix == ".parquet":
+            df.to_parquet(path, index=False)
+        else:
+            raise VicDrakeError(
+                f"--out must end in .parquet or .csv; got {str(path)!r}"
+            )
+        save_scenario(scenario, path.with_suffix(".scenario.yaml"))
+        out["log"] = str(path)
+    emit(out, args.json)
+    return 0

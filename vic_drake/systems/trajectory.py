@@ -1,0 +1,171 @@
+"""Reference sources of a scan: the target x_d(t) and the phantom lift.
+
+Pure functions build the profiles from the scenario
+(:func:`target_knots`, :func:`phantom_lift_m`); two thin LeafSystems expose
+them as ports:
+
+- :class:`TargetTrajectorySource`: outputs "target_position" (3, m) and
+  "target_velocity" (3, m/s) of a piecewise-linear target (a first-order-hold
+  ``PiecewisePolynomial``).
+- :class:`PhantomLiftSource`: output "phantom_lift" (1, m), the vertical
+  offset of the phantom (0 in nominal runs).
+
+Both are stateless functions of time.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from pydrake.systems.framework import BasicVector, LeafSystem
+
+from vic_drake.errors import VicDrakeError
+from vic_drake.scenario import DisturbanceConfig, TrajectoryConfig
+
+
+def target_knots(config: TrajectoryConfig) -> tuple[np.ndarray, np.ndarray]:
+    """Knots of the piecewise-linear target.
+
+    Args:
+        config: the trajectory (parametric profile or waypoint table).
+
+    Returns:
+        (t_s, p_m): times (n,) increasing, positions (3, n) in W. Steps (a
+        lift-off with ``liftoff_s = 0``) are a 1 ms ramp.
+    """
+    if config.waypoints:
+        table = np.asarray(config.waypoints, dtype=float)
+        return table[:, 0].copy(), table[:, 1:4].T.copy()
+    c = config
+    t = [0.0]
+    p = [(c.start_x_m, c.y_m, c.approach_z_m)]
+
+    def add(dt, xyz):
+        if dt > 0:
+            t.append(t[-1] + dt)
+            p.append(xyz)
+
+    add(c.start_delay_s, p[-1])
+    add(
+        (c.approach_z_m - c.target_z_m) / c.approach_speed_m_per_s,
+        (c.start_x_m, c.y_m, c.target_z_m),
+    )
+    add(c.dwell_s, p[-1])
+    add(
+        abs(c.end_x_m - c.start_x_m) / c.scan_speed_m_per_s,
+        (c.end_x_m, c.y_m, c.target_z_m),
+    )
+    add(c.end_dwell_s, p[-1])
+    if c.liftoff_height_m > 0:
+        add(
+            max(c.liftoff_s, 1e-3),
+            (c.end_x_m, c.y_m, c.target_z_m + c.liftoff_height_m),
+        )
+    if len(t) == 1:  # Motionless target: hold it.
+        add(1.0, p[-1])
+    return np.asarray(t), np.asarray(p, dtype=float).T
+
+
+def _smoothstep(u: np.ndarray) -> np.ndarray:
+    u = np.clip(u, 0.0, 1.0)
+    return u * u * (3.0 - 2.0 * u)
+
+
+def phantom_lift_m(t_s, config: DisturbanceConfig) -> np.ndarray:
+    """Phantom z offset at times t_s, m (vectorised).
+
+    Lifts rise and fall along smoothstep ramps (zero slope at both ends) and
+    add up; a table is interpolated linearly and held outside its range.
+    """
+    t = np.asarray(t_s, dtype=float)
+    if config.table:
+        table = np.asarray(config.table, dtype=float)
+        return np.interp(t, table[:, 0], table[:, 1])
+    z = np.zeros_like(t)
+    for lift in config.lifts:
+        up = _smoothstep((t - lift.start_s) / lift.rise_s)
+        t_fall = lift.start_s + lift.rise_s + lift.hold_s
+        down = _smoothstep((t - t_fall) / lift.fall_s)
+        z = z + lift.height_m * (up - down)
+    return z
+
+
+class TargetTrajectorySource(LeafSystem):
+    """The scan target x_d(t) from a :class:`TrajectoryConfig`.
+
+    Output ports:
+        target_position: (3,) p_WT, m.
+        target_velocity: (3,) v_WT, m/s (piecewise constant).
+    """
+
+    def __init__(self, config: TrajectoryConfig):
+        super().__init__()
+        from pydrake.trajectories import PiecewisePolynomial
+
+        if not isinstance(config, TrajectoryConfig):
+            raise VicDrakeError(
+                f"TargetTrajectorySource needs a TrajectoryConfig; got {config!r}"
+            )
+        t, p = target_knots(config)
+        self._trajectory = PiecewisePolynomial.FirstOrderHold(t, p)
+        self._velocity = self._trajectory.derivative(1)
+        self._t_end = float(t[-1])
+        self._position_port = self.DeclareVectorOutputPort(
+            "target_position", BasicVector(3), self._calc_position
+        )
+        self._velocity_port = self.DeclareVectorOutputPort(
+            "target_velocity", BasicVector(3), self._calc_velocity
+        )
+
+    @property
+    def trajectory(self):
+        """The PiecewisePolynomial of the target position (3 rows)."""
+        return self._trajectory
+
+    def get_target_position_output_port(self):
+        return self._position_port
+
+    def get_target_velocity_output_port(self):
+        return self._velocity_port
+
+    def _calc_position(self, context, output):
+        output.SetFromVector(self._trajectory.value(context.get_time()).ravel())
+
+    def _calc_velocity(self, context, output):
+        t = context.get_time()
+        if t >= self._t_end:
+            output.SetFromVector(np.zeros(3))
+        else:
+            output.SetFromVector(self._velocity.value(t).ravel())
+
+
+class PhantomLiftSource(LeafSystem):
+    """The phantom's vertical offset from a :class:`DisturbanceConfig`.
+
+    Output ports:
+        phantom_lift: (1,) z offset of the phantom, m.
+    """
+
+    def __init__(self, config: DisturbanceConfig):
+        super().__init__()
+        if not isinstance(config, DisturbanceConfig):
+            raise VicDrakeError(
+                f"PhantomLiftSource needs a DisturbanceConfig; got {config!r}"
+            )
+        self._config = config
+        self._port = self.DeclareVectorOutputPort(
+            "phantom_lift", BasicVector(1), self._calc
+        )
+
+    def get_phantom_lift_output_port(self):
+        return self._port
+
+    def _calc(self, context, output):
+        output.SetAtIndex(0, float(phantom_lift_m(context.get_time(), self._config)))
+
+
+__all__ = [
+    "PhantomLiftSource",
+    "TargetTrajectorySource",
+    "phantom_lift_m",
+    "target_knots",
+]
