@@ -349,3 +349,36 @@ def test_offline_figures(tmp_path):
     # Bars: 4 models x 2 logs.
     assert len(figures[0].axes[0].patches) == 8
     assert (tmp_path / "s.png").stat().st_size > 10_000
+
+
+def test_from_frame_drops_corrupt_rows():
+    t = 0.002 * np.arange(6)
+    df = pd.DataFrame(
+        {
+            "t_s": t[[0, 1, 3, 2, 3, 4, 5]],
+            "surface_z_m": [-0.05] * 7,
+            "z_target_m": [-0.06] * 7,
+            "z_m": [-0.05, -0.051, -0.053, -0.052, -0.053, np.nan, -0.055],
+            "vz_m_per_s": [0.0] * 7,
+            "force_z_N": [-1.0, -2.0, -4.0, -3.0, -4.0, -5.0, -6.0],
+        }
+    )
+    data = PalpationData.from_frame(df)
+    np.testing.assert_allclose(data.t_s, t[[0, 1, 2, 3, 5]])
+    np.testing.assert_allclose(data.force_N, [1.0, 2.0, 3.0, 4.0, 6.0])
+    df["z_m"] = np.nan
+    with pytest.raises(VicDrakeError, match="usable"):
+        PalpationData.from_frame(df)
+
+
+def test_samples_next_to_a_timestamp_gap_are_not_fitted():
+    data = synthetic_palpation(duration_s=6.0, jitter_s=0.0)
+    keep = (data.t_s < 2.0) | (data.t_s > 2.3)  # 0.3 s of dropped messages.
+    gappy = data.select(keep)
+    fit = fit_hunt_crossley(gappy, 1.35)
+    before, after = gappy.t_s[gappy.t_s < 2.1][-1], gappy.t_s[gappy.t_s > 2.1][0]
+    near = (gappy.t_s >= before - 0.05) & (gappy.t_s <= after + 0.05)
+    assert abs(fit.n_samples - (gappy.n - near.sum())) <= 1  # Rounding at the edges.
+    assert fit.n_samples < gappy.n - 45
+    assert fit.kappa == pytest.approx(4000.0, rel=1e-3)
+    assert fit.lam == pytest.approx(20000.0, rel=1e-2)

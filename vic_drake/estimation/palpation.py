@@ -62,6 +62,7 @@ from scipy.optimize import minimize_scalar
 from vic_drake.errors import VicDrakeError
 from vic_drake.estimation.signals import (
     DEFAULT_DERIVATIVE_WINDOW_S,
+    gap_free_mask,
     median_period,
     smoothed_derivatives,
 )
@@ -145,7 +146,8 @@ class PalpationData:
 
         Columns t_s, surface_z_m, z_target_m, z_m, force_z_N (sensor reading,
         negative = pressing; negated here). A constant surface column becomes
-        a float.
+        a float. Rows with non-finite values and repeated or out-of-order
+        timestamps are dropped (an error if fewer than half remain).
         """
         needed = ("t_s", "surface_z_m", "z_target_m", "z_m", "force_z_N")
         missing = [c for c in needed if c not in df.columns]
@@ -156,15 +158,28 @@ class PalpationData:
                 f"palpation/loadcycle layout); this one ({layout!r} layout) lacks "
                 f"{missing}"
             )
-        surface = df["surface_z_m"].to_numpy(float)
-        if surface.size and np.ptp(surface) == 0.0:
+        rows = df[list(needed)].to_numpy(float)
+        # Tolerate a few corrupt rows: non-finite values, repeated or
+        # out-of-order timestamps (kept: finite rows in time order, first of
+        # each timestamp).
+        rows = rows[np.all(np.isfinite(rows), axis=1)]
+        rows = rows[np.argsort(rows[:, 0], kind="stable")]
+        if rows.shape[0]:
+            rows = rows[np.concatenate([[True], np.diff(rows[:, 0]) > 0.0])]
+        if rows.shape[0] < max(2, 0.5 * len(df)):
+            raise VicDrakeError(
+                f"a palpation log needs finite rows with increasing timestamps; only "
+                f"{rows.shape[0]} of {len(df)} rows are usable"
+            )
+        t, surface, z_target, z, force_sensor = rows.T
+        if np.ptp(surface) == 0.0:
             surface = float(surface[0])
         return cls(
-            t_s=df["t_s"].to_numpy(float),
-            z_m=df["z_m"].to_numpy(float),
-            force_N=-df["force_z_N"].to_numpy(float),
+            t_s=t,
+            z_m=z,
+            force_N=-force_sensor,
             surface_z_m=surface,
-            z_target_m=df["z_target_m"].to_numpy(float),
+            z_target_m=z_target,
         )
 
     @property
@@ -248,11 +263,14 @@ class Kinematics:
         eps_m: s - z (smoothed z), m.
         eps_dot_m_per_s: s_dot - z_dot, m/s.
         z_ddot_m_per_s2: tip acceleration, m/s^2.
+        valid: True where no timestamp gap lies within one filter window
+            (see :func:`vic_drake.estimation.signals.gap_free_mask`).
     """
 
     eps_m: np.ndarray
     eps_dot_m_per_s: np.ndarray
     z_ddot_m_per_s2: np.ndarray
+    valid: np.ndarray | None = None
 
 
 def kinematics(
@@ -270,7 +288,10 @@ def kinematics(
             data.t_s, data.surface_z_m, window_s=window_s
         )
     return Kinematics(
-        eps_m=s - z, eps_dot_m_per_s=s_dot - z_dot, z_ddot_m_per_s2=z_ddot
+        eps_m=s - z,
+        eps_dot_m_per_s=s_dot - z_dot,
+        z_ddot_m_per_s2=z_ddot,
+        valid=gap_free_mask(data.t_s, window_s),
     )
 
 
@@ -300,6 +321,8 @@ def contact_mask(
     """Samples used by the fits: in contact and not a force spike."""
     eps = data.penetration_m if kin is None else kin.eps_m
     mask = (eps > min_penetration_m) & (data.force_N > min_force_N)
+    if kin is not None and kin.valid is not None:
+        mask &= kin.valid
     if spike_sigma is not None:
         mask &= spike_mask(data.force_N, sigma=spike_sigma)
     return mask
@@ -656,6 +679,7 @@ def lag_profile(
         t_pos = data.t_s - lag
         eps = np.interp(t_pos, data.t_s, kin.eps_m)
         mask = span & (eps > min_penetration_m)
+        mask &= np.interp(t_pos, data.t_s, kin.valid.astype(float)) > 0.999
         n = int(mask.sum())
         if n < MIN_CONTACT_SAMPLES:
             raise VicDrakeError(

@@ -80,6 +80,22 @@ def shift_signal(t_s, values, lag_s: float) -> np.ndarray:
     return out
 
 
+def gap_free_mask(t_s, window_s: float, *, max_gap_factor: float = 4.0) -> np.ndarray:
+    """True for samples farther than ``window_s`` from any timestamp gap.
+
+    A gap is a step longer than ``max_gap_factor`` median periods (dropped
+    messages). Derivatives bridged across a gap by the uniform resampling are
+    unreliable within one filter window of it.
+    """
+    t_s = np.asarray(t_s, dtype=float)
+    dt = np.diff(t_s)
+    gaps = np.flatnonzero(dt > max_gap_factor * median_period(t_s))
+    ok = np.ones(t_s.shape, bool)
+    for i in gaps:
+        ok &= (t_s < t_s[i] - window_s) | (t_s > t_s[i + 1] + window_s)
+    return ok
+
+
 def savgol_window_samples(window_s: float, period_s: float, polyorder: int) -> int:
     """Odd window length in samples for a ``window_s`` Savitzky-Golay filter."""
     if not window_s > 0.0:
