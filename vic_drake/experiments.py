@@ -680,6 +680,23 @@ def paper_scenarios(*, data_dir=None, include_real: bool = True) -> dict[str, Sc
     return out
 
 
+def write_paper_scenarios(
+    directory, *, data_dir=None, include_real: bool = True
+) -> list[Path]:
+    """Writes :func:`paper_scenarios` as ``<directory>/<name>.yaml`` (how
+    ``diagrams/`` was made), each with only the fields that differ from the
+    defaults; returns the paths."""
+    from vic_drake.scenario import save_scenario
+
+    directory = Path(directory)
+    return [
+        save_scenario(s, directory / f"{name}.yaml", only_changes=True)
+        for name, s in paper_scenarios(
+            data_dir=data_dir, include_real=include_real
+        ).items()
+    ]
+
+
 def _nominal_sibling(bag: Path) -> Path | None:
     """The nominal log beside a ``*_dist`` log, if present."""
     if bag.name.endswith("_dist"):

@@ -33,7 +33,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from vic_drake.control.fdcc import FdccParams
-from vic_drake.control.params import ControllerParams, ReferenceParams
+from vic_drake.control.params import (
+    ControllerParams,
+    ReferenceParams,
+    StiffnessQpParams,
+)
 from vic_drake.errors import VicDrakeError
 from vic_drake.station import StationParams
 from vic_drake.tissue.phantom import PHANTOM_KINDS
@@ -289,6 +293,14 @@ class LoggingConfig:
         _number("LoggingConfig", "period_s", self.period_s, low=0.0, low_open=True)
 
 
+def _vs_vf_controller() -> ControllerParams:
+    """VS-VF as on the real rig (test_nardi_matForce_lowR: R = 1e-5)."""
+    return ControllerParams(
+        qp=StiffnessQpParams(r_weight=[1e-5, 1e-5, 1e-5]),
+        reference=ReferenceParams(controller="vs-vf"),
+    )
+
+
 @dataclass
 class Scenario:
     """One closed-loop scan: phantom, station, controller, FDCC, references.
@@ -312,11 +324,7 @@ class Scenario:
     description: str = ""
     phantom: PhantomConfig = field(default_factory=PhantomConfig)
     station: StationParams = field(default_factory=StationParams)
-    controller: ControllerParams = field(
-        default_factory=lambda: ControllerParams(
-            reference=ReferenceParams(controller="vs-vf")
-        )
-    )
+    controller: ControllerParams = field(default_factory=lambda: _vs_vf_controller())
     fdcc: FdccParams = field(default_factory=FdccParams)
     trajectory: TrajectoryConfig = field(default_factory=TrajectoryConfig)
     disturbance: DisturbanceConfig = field(default_factory=DisturbanceConfig)
@@ -571,22 +579,35 @@ def _first_bad_field(value, tp, path: str) -> str | None:
     return None
 
 
-def dumps_scenario(scenario: Scenario) -> str:
-    """The scenario as YAML text (``yaml_dump_typed``), loadable by load_scenario."""
+def dumps_scenario(scenario: Scenario, *, only_changes: bool = False) -> str:
+    """The scenario as YAML text (``yaml_dump_typed``), loadable by load_scenario.
+
+    Args:
+        scenario: what to write.
+        only_changes: write only the fields that differ from ``Scenario()``
+            (Drake's ``defaults=``), as the files in ``diagrams/`` do: short,
+            and they follow improvements of the defaults. False (default)
+            writes every field: the exact record of a run.
+    """
     from pydrake.common.yaml import yaml_dump_typed
 
     if not isinstance(scenario, Scenario):
         raise VicDrakeError(
             f"dumps_scenario needs a Scenario; got {type(scenario).__name__}"
         )
-    return yaml_dump_typed(_to_twin(scenario), schema=_twin_class(Scenario))
+    defaults = _to_twin(Scenario()) if only_changes else None
+    return yaml_dump_typed(
+        _to_twin(scenario), schema=_twin_class(Scenario), defaults=defaults
+    )
 
 
-def save_scenario(scenario: Scenario, path: str | os.PathLike) -> Path:
-    """Writes the scenario as YAML (``yaml_dump_typed``); returns the path."""
+def save_scenario(
+    scenario: Scenario, path: str | os.PathLike, *, only_changes: bool = False
+) -> Path:
+    """Writes the scenario as YAML (see :func:`dumps_scenario`); returns the path."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(dumps_scenario(scenario))
+    path.write_text(dumps_scenario(scenario, only_changes=only_changes))
     return path
 
 
