@@ -1,0 +1,66 @@
+"""`vic-drake compare-real` and `vic-drake scan`: contract keys and bad input."""
+
+import json
+
+import pytest
+
+from vic_drake.cli import main
+from vic_drake.commands.scans import COMPARE_KEYS
+
+
+def test_compare_real_missing_bag_is_a_clean_error(tmp_path, capsys):
+    assert main(["compare-real", str(tmp_path / "nope")]) == 2
+    assert "does not exist" in capsys.readouterr().err
+
+
+def test_compare_real_rejects_bad_numbers(tmp_path, capsys):
+    assert main(["compare-real", str(tmp_path), "--force", "-3"]) == 2
+    assert "--force" in capsys.readouterr().err
+
+
+@pytest.mark.realdata
+def test_compare_real_rejects_palpation_bag(data_dir, capsys):
+    assert main(["compare-real", str(data_dir / "palpation" / "test_soft_1hz")]) == 2
+    assert "6 columns" in capsys.readouterr().err
+
+
+@pytest.mark.realdata
+def test_compare_real_unknown_9_column_log_needs_controller(data_dir, tmp_path, capsys):
+    src = data_dir / "experiments" / "test_force_control"
+    dst = tmp_path / "mystery_scan"
+    dst.mkdir()
+    for f in src.iterdir():
+        (dst / f.name.replace("test_force_control", "mystery_scan")).write_bytes(
+            f.read_bytes()
+        )
+    meta = dst / "metadata.yaml"
+    meta.write_text(meta.read_text().replace("test_force_control", "mystery_scan"))
+    assert main(["compare-real", str(dst), "--json"]) == 2
+    assert "--controller" in capsys.readouterr().err
+
+
+@pytest.mark.realdata
+def test_compare_real_short_run_prints_the_contract_keys(data_dir, capsys):
+    bag = data_dir / "experiments" / "test_tracking5"
+    status = main(["compare-real", str(bag), "--duration", "2.5", "--json"])
+    assert status == 0
+    out = json.loads(capsys.readouterr().out)
+    assert list(out)[: len(COMPARE_KEYS)] == list(COMPARE_KEYS)
+    assert out["controller"] == "vs-cf"
+    assert out["duration_s"] == pytest.approx(2.5)
+    assert out["force_rmse_N"] >= 0 and out["rtf"] > 0
+
+
+def test_scan_command_runs_a_scenario_file(tmp_path, capsys):
+    from vic_drake.experiments import synthetic_scenario
+    from vic_drake.scenario import save_scenario
+
+    path = save_scenario(synthetic_scenario("cs"), tmp_path / "cs.yaml")
+    out_file = tmp_path / "log.csv"
+    assert (
+        main(["scan", str(path), "--duration", "0.1", "--out", str(out_file), "--json"])
+        == 0
+    )
+    out = json.loads(capsys.readouterr().out)
+    assert out["controller"] == "cs" and out_file.is_file()
+    assert (tmp_path / "log.scenario.yaml").is_file()
