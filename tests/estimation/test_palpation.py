@@ -238,6 +238,9 @@ def test_lag_profile_is_minimal_at_the_true_lag():
     prof = lag_profile(data, 0.1)
     assert prof.lags_s[0] == 0.0 and prof.lags_s[-1] <= 0.1 + 1e-12
     assert abs(prof.lags_s[np.argmin(prof.rms_N)] - 0.03) <= 0.0021
+    lo, hi = prof.flat_range(0.01)
+    assert lo <= prof.lags_s[np.argmin(prof.rms_N)] <= hi
+    assert prof.flat_range(1e6) == (0.0, prof.lags_s[-1])
     with pytest.raises(VicDrakeError, match="max_lag_s"):
         lag_profile(data, -0.1)
 
@@ -329,6 +332,7 @@ def test_offline_figures(tmp_path):
 
     from vic_drake.plots.offline import (
         plot_beta_sweep,
+        plot_lag_profile,
         plot_palpation_summary,
         plot_residual_vs_time,
         plot_table_i,
@@ -341,6 +345,7 @@ def test_offline_figures(tmp_path):
         plot_table_i({"synthetic": comparison, "again": comparison}),
         plot_beta_sweep(comparison.sweep),
         plot_residual_vs_time({"synthetic": curve}),
+        plot_lag_profile(comparison.lag_profile),
         plot_palpation_summary(
             comparison, title="synthetic", save_path=tmp_path / "s.png"
         ),

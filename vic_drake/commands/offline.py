@@ -161,9 +161,13 @@ def _fit_palpation(args: argparse.Namespace) -> int:
 
         plot_palpation_summary(result, title=str(args.bag_dir), save_path=args.plot)
         say(f"wrote {args.plot}")
+    lag_note = ""
+    if result.lag_profile is not None:
+        lo, hi = result.lag_profile.flat_range(0.01)
+        lag_note = f"; residual within 1 % of its minimum for lags {lo * 1e3:.0f}-{hi * 1e3:.0f} ms"
     lines = [
         f"palpation {args.bag_dir}: {kv.n_samples} in-contact samples",
-        f"sensor lag {result.lag_s * 1e3:.1f} ms (force behind position)",
+        f"sensor lag {result.lag_s * 1e3:.1f} ms (force behind position){lag_note}",
         f"{'model':<22}{'rms [N]':>10}{'relative':>10}   parameters",
         f"{'Kelvin-Voigt':<22}{kv.rms_N:>10.4f}{kv.relative:>10.4f}   "
         f"k = {kv.k:.1f} N/m, d = {kv.d:.2f} N s/m",

@@ -636,6 +636,21 @@ class LagProfile:
     lag_s: float
     beta: float
 
+    def flat_range(self, tolerance: float = 0.01) -> tuple[float, float]:
+        """Lags whose residual is within ``tolerance`` (relative) of the best.
+
+        A wide range means the lag is poorly identified by this log (see the
+        module docstring); the contiguous range around the minimiser is given.
+        """
+        limit = (1.0 + tolerance) * float(np.min(self.rms_N))
+        best = int(np.argmin(self.rms_N))
+        lo = hi = best
+        while lo > 0 and self.rms_N[lo - 1] <= limit:
+            lo -= 1
+        while hi < self.rms_N.size - 1 and self.rms_N[hi + 1] <= limit:
+            hi += 1
+        return float(self.lags_s[lo]), float(self.lags_s[hi])
+
 
 def lag_profile(
     data: PalpationData,
@@ -815,12 +830,14 @@ class ModelComparison:
         kelvin_voigt: the KV fit.
         hunt_crossley: beta -> HC fit (in the order given).
         sweep: the beta sweep over [1.0, 2.0], or None.
+        lag_profile: the lag search, or None when the lag was given.
     """
 
     lag_s: float
     kelvin_voigt: KelvinVoigtFit
     hunt_crossley: dict[float, HuntCrossleyFit]
     sweep: BetaSweep | None = None
+    lag_profile: LagProfile | None = None
 
     @property
     def best_beta(self) -> float | None:
@@ -857,14 +874,16 @@ def compare_models(
     """
     say = progress or (lambda _msg: None)
     betas = [_check_beta(b) for b in betas]
+    profile = None
     if lag_s is None:
         say(f"estimating the sensor lag over [0, {max_lag_s:g}] s")
-        lag_s = estimate_lag(
+        profile = lag_profile(
             data,
             max_lag_s,
             indenter_mass_kg=indenter_mass_kg,
             derivative_window_s=derivative_window_s,
         )
+        lag_s = profile.lag_s
     aligned = shift(data, lag_s)
     kw = dict(
         indenter_mass_kg=indenter_mass_kg, derivative_window_s=derivative_window_s
@@ -877,7 +896,11 @@ def compare_models(
         say("sweeping beta over [1.0, 2.0]")
         result_sweep = sweep_beta(aligned, **kw)
     return ModelComparison(
-        lag_s=float(lag_s), kelvin_voigt=kv, hunt_crossley=hc, sweep=result_sweep
+        lag_s=float(lag_s),
+        kelvin_voigt=kv,
+        hunt_crossley=hc,
+        sweep=result_sweep,
+        lag_profile=profile,
     )
 
 

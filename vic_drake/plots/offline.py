@@ -1,5 +1,5 @@
 """Figures of the offline phase: Table I, Fig. 2 (load test), Fig. 3
-(residual vs palpation time) and the beta sweep.
+(residual vs palpation time), the beta sweep and the sensor-lag search.
 
 Every function takes results of :mod:`vic_drake.estimation` and returns a
 matplotlib Figure; the only I/O is the optional ``save_path``.
@@ -16,6 +16,7 @@ from vic_drake.estimation.loadtest import LoadTestResult
 from vic_drake.estimation.palpation import (
     PAPER_TABLE_I,
     BetaSweep,
+    LagProfile,
     ModelComparison,
     ResidualCurve,
 )
@@ -157,6 +158,29 @@ def plot_residual_vs_time(
     ax.axvline(5.0, color="k", ls="--", alpha=0.4, label="paper's 5 s")
     ax.set_xlabel("palpation time [s]")
     ax.set_ylabel("relative residual on the whole log")
+    if title:
+        ax.set_title(title)
+    ax.legend(fontsize="small")
+    ax.grid(alpha=0.3)
+    return _finish(fig, save_path)
+
+
+def plot_lag_profile(
+    profiles: LagProfile | Mapping[str, LagProfile],
+    *,
+    title: str | None = "Sensor-lag search (reference HC fit)",
+    save_path=None,
+) -> Figure:
+    """RMS residual (relative to each log's minimum) against candidate lag."""
+    profiles = _as_mapping(profiles, "log")
+    fig = Figure(figsize=(6.0, 4.0))
+    ax = fig.add_subplot()
+    for name, prof in profiles.items():
+        (line,) = ax.plot(1e3 * prof.lags_s, prof.rms_N / prof.rms_N.min(), label=name)
+        ax.axvline(1e3 * prof.lag_s, color=line.get_color(), ls=":")
+    ax.axvline(56.0, color="k", ls="--", alpha=0.4, label="real controller: 28 ticks")
+    ax.set_xlabel("lag of force behind position [ms]")
+    ax.set_ylabel("RMS residual / minimum")
     if title:
         ax.set_title(title)
     ax.legend(fontsize="small")
