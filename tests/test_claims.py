@@ -83,6 +83,16 @@ def test_c3_three_strong_one_weak_rib_passes():
     assert C.claim_c3(d, d).passed
 
 
+def test_c3_spurious_close_peaks_fail():
+    x = np.linspace(-0.1, 0.1, 401)
+    y = np.linspace(-0.05, 0.05, 11)
+    prof = 5000 + 2000 * np.cos(2 * np.pi * x / 0.01) ** 2  # "ribs" every 1 cm
+    prof[np.abs(x) < 0.02] -= 1500
+    d = C.rib_prominences(x, y, np.repeat(prof[:, None], y.size, axis=1))
+    assert d["min_spacing_m"] < 0.02
+    assert not C.claim_c3(d, None).pass_sim
+
+
 def test_c3_equal_ribs_or_no_ribs_fail():
     equal = C.rib_prominences(*_rib_map([3000, 3000, 3000, 3000]))
     assert equal["n_weak"] == 0 and not C.claim_c3(equal, None).pass_sim

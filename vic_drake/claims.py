@@ -62,6 +62,10 @@ C3_STRONG_RELATIVE = 0.15
 C3_WEAK_FRACTION = 0.5
 #: C3: the paper's counts: three evident ribs and at least one weaker one.
 C3_MIN_STRONG_RIBS = 3
+#: C3: neighbouring ribs are at least this far apart (m); closer peaks are
+#: texture or an over-fitted map, not ribs (the chest's ribs are ~4 cm apart,
+#: intercostal spaces >= 2 cm).
+C3_MIN_RIB_SPACING_M = 0.02
 #: C4: VS-CF's force RMSE may exceed CF's by at most 20 % (the issue's
 #: "about as well as CF").
 C4_MAX_RMSE_RATIO = 1.2
@@ -390,12 +394,15 @@ def rib_prominences(x_m, y_m, kappa, *, across: str = "x") -> dict:
         "n_strong": int((strong & ~weak).sum()),
         "n_weak": int(weak.sum()),
         "weakest_to_median_strong": float(prom.min() / ref) if strong.any() else None,
+        "min_spacing_m": float(np.min(np.diff(np.sort(axis[peaks])))) if peaks.size > 1
+        else None,
         "median_kappa": median,
     }
 
 
 def _c3_pass(d: dict) -> bool:
-    return bool(d["n_strong"] >= C3_MIN_STRONG_RIBS and d["n_weak"] >= 1)
+    spacing_ok = d.get("min_spacing_m") is None or d["min_spacing_m"] >= C3_MIN_RIB_SPACING_M
+    return bool(d["n_strong"] >= C3_MIN_STRONG_RIBS and d["n_weak"] >= 1 and spacing_ok)
 
 
 def claim_c3(sim: dict | None, real: dict | None, *, reason_sim: str | None = None,
@@ -410,7 +417,8 @@ def claim_c3(sim: dict | None, real: dict | None, *, reason_sim: str | None = No
               f"{C3_MIN_RIB_PROMINENCE:.0%} of median kappa; strong = prominence >= "
               f"{C3_STRONG_RELATIVE:.0%} of median kappa; weak = prominence <= "
               f"{C3_WEAK_FRACTION:.0%} of the strong ribs' median; pass: >= "
-              f"{C3_MIN_STRONG_RIBS} strong ribs and >= 1 weak rib")
+              f"{C3_MIN_STRONG_RIBS} strong ribs, >= 1 weak rib, ribs >= "
+              f"{C3_MIN_RIB_SPACING_M * 100:g} cm apart")
     extra = _not_evaluated(reason_sim if sim is None else None,
                            reason_real if real is None else None)
     return Claim("C3", STATEMENTS["C3"],
