@@ -36,11 +36,16 @@ coarse rigid hydroelastic geometry that meets the phantom's compliant
 hydroelastic volume mesh (:mod:`vic_drake.models.phantom_mesh`): a safety
 contact, not the measured force.
 
-The arm is position controlled, as the real UR3e: each joint has Drake's
-implicit PD actuator (``JointActuator.set_controller_gains``) tracking the
-commanded position, with the finite-differenced command as desired velocity
-and the arm's gravity torques as feed-forward (the UR controller compensates
-gravity itself). Effort limits are the URDF's (56, 56, 28, 12, 12, 12 N m).
+The arm is position controlled, as the real UR3e: the streamed joint
+command (500 Hz) is smoothed by a first-order filter (``servo_time_constant_s``
+0.03 s, the UR driver's servoj lookahead) and, with an integral of the
+tracking error (``servo_integral_time_s``), is the desired state of Drake's
+implicit PD actuators (``JointActuator.set_controller_gains``, gains
+``joint_kp_Nm_per_rad``/``joint_kd_Nms_per_rad``), with the arm's gravity
+torques as feed-forward (the UR controller compensates gravity itself).
+Effort limits are the URDF's (56, 56, 28, 12, 12, 12 N m). The servo lag
+matters: FDCC re-reads the measured joints every tick, and with an ideal
+servo the FZI gains' force loop is unstable against the sensor's 56 ms lag.
 """
 
 from __future__ import annotations
@@ -146,6 +151,12 @@ class StationParams:
     # Damping per joint, N m s/rad (about critical for the arm's inertia).
     joint_kd_Nms_per_rad: tuple[float, ...] = (120.0, 120.0, 60.0, 8.0, 8.0, 8.0)
     command_period_s: float = 0.002  # Period of the position command (500 Hz), s.
+    # Time constant of the command smoothing, s: the UR driver's servoj
+    # lookahead_time (0.03 s); the arm tracks commands with this lag.
+    servo_time_constant_s: float = 0.03
+    # Integral time of the servo's tracking-error integral, s (0 = none):
+    # removes the static error a load would leave with the PD alone.
+    servo_integral_time_s: float = 0.05
     # -- BOTA SensONE F/T sensor ---------------------------------------------
     ft_mount_mass_kg: float = 0.149  # Mounting-side mass, kg.
     ft_wrench_mass_kg: float = 0.081  # Wrench-side mass, kg.
@@ -176,7 +187,7 @@ class StationParams:
 
     def __post_init__(self):
         positive = (
-            "time_step_s", "gravity_m_per_s2", "command_period_s", "ft_mount_mass_kg",
+            "time_step_s", "gravity_m_per_s2", "command_period_s", "servo_time_constant_s", "ft_mount_mass_kg",
             "ft_wrench_mass_kg", "ft_wrench_offset_m", "ft_radius_m", "sensor_period_s",
             "indenter_mass_kg", "indenter_length_m", "indenter_tip_radius_m",
             "phantom_mass_kg", "phantom_kp_N_per_m", "phantom_mesh_resolution_m",
@@ -187,7 +198,7 @@ class StationParams:
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and np.isfinite(value) and value > 0):
                 raise VicDrakeError(f"StationParams.{name} must be a number > 0, got {value!r}")
-        nonneg = ("sensor_torque_noise_std_Nm", "phantom_kd_Ns_per_m",
+        nonneg = ("servo_integral_time_s", "sensor_torque_noise_std_Nm", "phantom_kd_Ns_per_m",
                   "hunt_crossley_dissipation_s_per_m", "friction_coefficient")
         for name in nonneg:
             value = getattr(self, name)
@@ -451,6 +462,76 @@ def probe_pose(q, params: StationParams | None = None) -> RigidTransform:
 # ----------------------------------------------------------------------------
 
 
+def joint_filter_step(q_filtered, q_command, period_s: float, time_constant_s: float):
+    """One step of the servo's first-order command smoothing.
+
+    Returns (q_filtered_next, v_desired): the filtered position moves a
+    fraction ``1 - exp(-period/tau)`` of the way to the command; the desired
+    velocity is the filtered position's rate over the next period.
+    """
+    alpha = 1.0 - np.exp(-period_s / time_constant_s)
+    q_next = q_filtered + alpha * (np.asarray(q_command, float) - q_filtered)
+    return q_next, (q_next - q_filtered) / period_s
+
+
+class JointCommandFilter(LeafSystem):
+    """The arm's position servo front end: command -> desired state of the PD.
+
+    Models what the UR controller does with streamed position commands:
+
+    - a discrete first-order filter (period ``period_s``, time constant
+      ``time_constant_s``), as the servoj lookahead smooths the stream;
+    - integral action on the tracking error (time constant
+      ``integral_time_s``; 0 disables it): the desired position is the
+      filtered command plus the integral of (filtered command - measured
+      position), so a static load (the tissue pushing on the probe) leaves no
+      steady position error -- the real arm holds its pose under 10 N to a
+      fraction of a millimetre.
+
+    Input ports ``command`` (n) and ``measured_position`` (n); output
+    ``desired_state`` (2n: desired q, desired velocity) for the plant's PD
+    actuators. State: filtered q, its rate, integral term. Use
+    :meth:`set_state` when starting elsewhere than ``initial_q``.
+    """
+
+    def __init__(self, n: int, period_s: float, time_constant_s: float, initial_q,
+                 integral_time_s: float = 0.0):
+        super().__init__()
+        self._n, self._period, self._tau = int(n), float(period_s), float(time_constant_s)
+        self._ti = float(integral_time_s)
+        self._in = self.DeclareVectorInputPort("command", self._n)
+        self._measured = self.DeclareVectorInputPort("measured_position", self._n)
+        q0 = np.asarray(initial_q, float).reshape(self._n)
+        self._state = self.DeclareDiscreteState(np.concatenate([q0, np.zeros(2 * self._n)]))
+        self.DeclarePeriodicDiscreteUpdateEvent(self._period, 0.0, self._update)
+        self.DeclareVectorOutputPort(
+            "desired_state", 2 * self._n, self._calc_desired,
+            prerequisites_of_calc={self.xd_ticket()},
+        )
+
+    def set_state(self, context, q) -> None:
+        """Sets the filter at rest at q (n,), with no integral term."""
+        context.SetDiscreteState(
+            self._state, np.concatenate([np.asarray(q, float), np.zeros(2 * self._n)])
+        )
+
+    def _update(self, context, discrete_state):
+        n = self._n
+        x = context.get_discrete_state(self._state).get_value()
+        q_f, integral = x[:n], x[2 * n :]
+        if self._ti > 0:
+            integral = integral + (self._period / self._ti) * (
+                q_f - self._measured.Eval(context)
+            )
+        q, v = joint_filter_step(q_f, self._in.Eval(context), self._period, self._tau)
+        discrete_state.set_value(self._state, np.concatenate([q, v, integral]))
+
+    def _calc_desired(self, context, output):
+        n = self._n
+        x = context.get_discrete_state(self._state).get_value()
+        output.SetFromVector(np.concatenate([x[:n] + x[2 * n :], x[n : 2 * n]]))
+
+
 class PointKinematics(LeafSystem):
     """Position and velocity in W of a point fixed on a body.
 
@@ -482,7 +563,12 @@ class PointKinematics(LeafSystem):
         X_WB = self._poses.Eval(context)[self._body]
         V_WB = self._vels.Eval(context)[self._body]
         p_BQ_W = X_WB.rotation() @ self._p_BQ
-        output.SetFromVector(V_WB.translational() + np.cross(V_WB.rotational(), p_BQ_W))
+        w = V_WB.rotational()
+        output.SetFromVector(V_WB.translational() + np.array([
+            w[1] * p_BQ_W[2] - w[2] * p_BQ_W[1],
+            w[2] * p_BQ_W[0] - w[0] * p_BQ_W[2],
+            w[0] * p_BQ_W[1] - w[1] * p_BQ_W[0],
+        ]))
 
 
 def _set_pd_gains(plant, joint_names, model, kp, kd):
@@ -624,13 +710,19 @@ def MakeStation(
             raise VicDrakeError(f"initial_q must be 6 finite joint angles (rad), got {initial_q!r}")
         plant.SetDefaultPositions(ur3e, q0)
 
-    # Position servo: desired state [q_cmd, d/dt q_cmd] for the PD actuators.
-    ur_interp = builder.AddNamedSystem(
-        "ur3e_command_interpolator",
-        StateInterpolatorWithDiscreteDerivative(6, params.command_period_s, True),
+    # Position servo: the command, smoothed as the UR's servoj does, is the
+    # desired state of the PD actuators.
+    q_default = plant.GetDefaultPositions(ur3e)
+    ur_measured = builder.AddNamedSystem("ur3e_state_demux", Demultiplexer([6, 6]))
+    ur_filter = builder.AddNamedSystem(
+        "ur3e_servo_filter",
+        JointCommandFilter(6, params.command_period_s, params.servo_time_constant_s, q_default,
+                           params.servo_integral_time_s),
     )
-    builder.Connect(ur_interp.get_output_port(), plant.get_desired_state_input_port(ur3e))
-    builder.ExportInput(ur_interp.get_input_port(), "ur3e.position_command")
+    builder.Connect(plant.get_state_output_port(ur3e), ur_measured.get_input_port())
+    builder.Connect(ur_measured.get_output_port(0), ur_filter.GetInputPort("measured_position"))
+    builder.Connect(ur_filter.get_output_port(), plant.get_desired_state_input_port(ur3e))
+    builder.ExportInput(ur_filter.GetInputPort("command"), "ur3e.position_command")
     lift_interp = builder.AddNamedSystem(
         "phantom_lift_interpolator",
         StateInterpolatorWithDiscreteDerivative(1, params.command_period_s, True),
@@ -737,6 +829,8 @@ def set_station_state(station: Diagram, station_context, q, *, phantom_lift_m: f
     ur3e = plant.GetModelInstanceByName("ur3e")
     plant.SetPositions(plant_context, ur3e, np.asarray(q, float))
     plant.SetVelocities(plant_context, ur3e, np.zeros(6))
+    servo = station.GetSubsystemByName("ur3e_servo_filter")
+    servo.set_state(station.GetMutableSubsystemContext(servo, station_context), q)
     phantom = plant.GetModelInstanceByName("phantom")
     plant.SetPositions(plant_context, phantom, [phantom_lift_m])
     plant.SetVelocities(plant_context, phantom, [0.0])
