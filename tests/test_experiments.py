@@ -48,6 +48,22 @@ def test_short_run_returns_the_canonical_frame():
     assert result.rtf > 0 and result.wall_s > 0
 
 
+def test_scan_figures_draw_sim_and_real(tmp_path):
+    from vic_drake.plots.scans import plot_comparison, plot_fig6, plot_fig7
+
+    df = run_scan(synthetic_scenario("vs-cf"), duration_s=0.1).df
+    fig = plot_fig6(
+        {"vs-cf": df, "vs-vf": df}, {"vs-vf": df}, save_path=tmp_path / "f6.png"
+    )
+    assert len(fig.axes) == 8 and (tmp_path / "f6.png").stat().st_size > 0
+    fig = plot_fig7({"vs-vf": df, "cs": df, "cf": df})
+    assert len(fig.axes) == 9
+    fig = plot_comparison(df, df)
+    assert len(fig.axes) == 3
+    with pytest.raises(VicDrakeError):
+        plot_fig6({})
+
+
 def test_run_scan_rejects_bad_input():
     with pytest.raises(VicDrakeError, match="duration_s"):
         run_scan(synthetic_scenario("cs"), duration_s=-1.0)

@@ -14,6 +14,7 @@ from vic_drake.metrics import (
     estimate_time_offset_s,
     force_range_N,
     force_rmse_N,
+    lead_force,
     lift_table,
     lifted_off,
     peak_force_N,
@@ -79,6 +80,17 @@ def test_time_offset_recovers_a_known_shift():
     real = make_scan(t, 5 + signal)
     sim = make_scan(t - 0.13, 5 + signal)  # Sim runs 0.13 s early.
     assert estimate_time_offset_s(sim, real) == pytest.approx(0.13, abs=0.011)
+
+
+def test_force_lead_undoes_a_sensor_lag():
+    t = np.arange(0, 20, 0.002)
+    f = 5 + np.sin(t)
+    lagged = make_scan(t, np.interp(t - 0.056, t, f), z_m=0.1, tank_energy_J=0.5)
+    real = make_scan(t, f, z_m=0.1, tank_energy_J=0.5)
+    led = lead_force(lagged, 0.056)
+    np.testing.assert_allclose(-led["force_sensor_z_N"][:-100], f[:-100], atol=1e-9)
+    out = compare_with_real(lagged, real, align=False, force_lead_s=0.056)
+    assert out["force_rmse_N"] < 1e-6
 
 
 def test_compare_identical_records_is_perfect():

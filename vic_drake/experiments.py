@@ -782,7 +782,11 @@ def compare_real(
     result = run_scan(
         scenario, phantom=phantom, duration_s=duration_s, progress=progress
     )
-    metrics = compare_with_real(result.df, real)
+    lead = 0.0
+    if raw.attrs["layout"] == "scan":  # Force logged 28 ticks after its pose.
+        st = scenario.station
+        lead = st.sensor_lag_samples * st.sensor_period_s
+    metrics = compare_with_real(result.df, real, force_lead_s=lead)
     out = {
         "controller": scenario.controller.reference.controller,
         "duration_s": result.sim_s,

@@ -363,13 +363,38 @@ def shift_time(df: pd.DataFrame, offset_s: float) -> pd.DataFrame:
     return out
 
 
+def lead_force(df: pd.DataFrame, lead_s: float) -> pd.DataFrame:
+    """A copy whose force columns are advanced by lead_s (value at t + lead_s).
+
+    The 9-column CS/CF logs store each pose with the force read 28 ticks
+    later, which undoes the sensor's lag; a simulated sensor with that lag is
+    put on the same footing by advancing its force by the same time.
+    """
+    if lead_s == 0:
+        return df
+    out = df.copy()
+    t = df["t_s"].to_numpy(float)
+    for c in ("force_sensor_x_N", "force_sensor_y_N", "force_sensor_z_N"):
+        v = df[c].to_numpy(float)
+        out[c] = np.interp(t + lead_s, t, v, right=np.nan)
+    return out
+
+
 def compare_with_real(
-    sim: pd.DataFrame, real: pd.DataFrame, *, align: bool = True, max_lag_s: float = 0.5
+    sim: pd.DataFrame,
+    real: pd.DataFrame,
+    *,
+    align: bool = True,
+    max_lag_s: float = 0.5,
+    force_lead_s: float = 0.0,
 ) -> dict:
     """Metrics of a simulated scan against the real log of the same experiment.
 
-    The simulated record is shifted by :func:`estimate_time_offset_s` (when
-    ``align``), resampled at the real log's times over the real scan window
+    The simulated force is first advanced by ``force_lead_s`` (see
+    :func:`lead_force`; 0 for the 31-column logs, whose force is the raw,
+    lagged sensor reading like the simulated one). The simulated record is
+    then shifted by :func:`estimate_time_offset_s` (when ``align``),
+    resampled at the real log's times over the real scan window
     (:func:`scan_window` of the real log: first contact + SETTLE_S to last
     contact), and compared there.
 
@@ -386,6 +411,7 @@ def compare_with_real(
     _require(
         real, "t_s", "z_m", "force_sensor_z_N", "stiffness_z_N_per_m", "tank_energy_J"
     )
+    sim = lead_force(sim, force_lead_s)
     offset = estimate_time_offset_s(sim, real, max_lag_s=max_lag_s) if align else 0.0
     sim_s = shift_time(sim, offset)
     window = scan_window(real)
@@ -422,6 +448,7 @@ def compare_with_real(
         "z_rmse_mm": float(1e3 * np.sqrt(np.mean(z_err**2))),
         "kz_corr": kz_corr,
         "time_offset_s": float(offset),
+        "force_lead_s": float(force_lead_s),
         "window_s": [float(t[valid][0]), float(t[valid][-1])],
         "force_peak_sim_N": peak_sim,
         "force_peak_real_N": peak_real,
@@ -559,6 +586,7 @@ __all__ = [
     "estimate_time_offset_s",
     "force_range_N",
     "force_rmse_N",
+    "lead_force",
     "lift_table",
     "lifted_off",
     "liftoff_clearance_m",
