@@ -117,14 +117,17 @@ def test_infeasible_returns_k_min(osqp, clarabel):
 
 def test_program_is_built_once(osqp):
     prog = osqp.prog
-    bindings = (len(prog.quadratic_costs()), len(prog.linear_constraints()),
-                len(prog.bounding_box_constraints()))  # fmt: skip
+    cost, rows = prog.quadratic_costs()[0], prog.linear_constraints()[0]
     for ez in (-0.01, -0.02, -0.03):
         osqp.solve(problem((0.001, -0.002, ez), (0.01, 0.0, 0.02)))
     assert osqp.prog is prog
-    assert bindings == (1, 2, 1)
-    assert (len(prog.quadratic_costs()), len(prog.linear_constraints()),
-            len(prog.bounding_box_constraints())) == bindings  # fmt: skip
+    assert len(prog.quadratic_costs()) == 1 and len(prog.linear_constraints()) == 1
+    assert prog.quadratic_costs()[0].evaluator() is cost.evaluator() or (
+        prog.quadratic_costs()[0].evaluator().get_description()
+        == cost.evaluator().get_description()
+    )
+    assert prog.linear_constraints()[0].evaluator().num_constraints() == 8
+    assert rows.evaluator().GetDenseA()[5, 2] != 0.0  # Updated in place: z force row.
 
 
 vec = lambda s: st.tuples(*[st.floats(-s, s)] * 3)  # noqa: E731
@@ -207,3 +210,18 @@ def test_unknown_solver_is_a_clear_error():
 
     with pytest.raises(VicDrakeError, match="'osqp', 'clarabel' or 'exact'"):
         StiffnessQp("gurobi")
+
+
+@settings(max_examples=100, deadline=None)
+@given(p=random_problems(), energy=st.floats(0.0, 1.5), dt=st.floats(1e-4, 0.01))
+def test_problem_tank_rows_equal_the_tank_module(p, energy, dt):
+    from vic_drake.control.tank import tank_qp_rows
+
+    q = make_stiffness_qp_problem(p.e, p.e_dot, p.damping, p.force_ref, p.force_min, energy, dt,
+                                  StiffnessQpParams(r_weight=list(p.r_weight)), TANK)  # fmt: skip
+    a, lb_energy, lb_power = tank_qp_rows(
+        energy, p.e, p.e_dot, K_MIN, p.damping, dt, TANK
+    )
+    assert q.tank_a == pytest.approx(a, rel=1e-15)
+    assert q.tank_lb_energy == pytest.approx(lb_energy, rel=1e-12, abs=1e-12)
+    assert q.tank_lb_power == pytest.approx(lb_power, rel=1e-12, abs=1e-15)

@@ -39,7 +39,6 @@ from typing import NamedTuple
 import numpy as np
 
 from vic_drake.control.params import StiffnessQpParams, TankParams
-from vic_drake.control.tank import tank_qp_rows
 from vic_drake.errors import VicDrakeError
 
 AXES = ("x", "y", "z")
@@ -138,27 +137,31 @@ def make_stiffness_qp_problem(
         qp, tank: parameters (K bounds, weights, F_max, T_min, eta).
         force_max: F_max (3,), N; default ``qp.force_max_N``.
     """
-    e = (float(e[0]), float(e[1]), float(e[2]))
-    e_dot = (float(e_dot[0]), float(e_dot[1]), float(e_dot[2]))
-    damping = (float(damping[0]), float(damping[1]), float(damping[2]))
-    k_min = tuple(qp.stiffness_min_N_per_m)
-    a, lb_energy, lb_power = tank_qp_rows(energy_J, e, e_dot, k_min, damping, dt, tank)
+    e0, e1, e2 = float(e[0]), float(e[1]), float(e[2])
+    v0, v1, v2 = float(e_dot[0]), float(e_dot[1]), float(e_dot[2])
+    d0, d1, d2 = float(damping[0]), float(damping[1]), float(damping[2])
+    k_min = qp.stiffness_min_N_per_m
+    # The tank rows (vic_drake.control.tank.tank_qp_rows), inlined for speed.
+    sigma = 0.0 if energy_J >= tank.max_energy_J else 1.0
+    a = (e0 * v0, e1 * v1, e2 * v2)
+    base = a[0] * k_min[0] + a[1] * k_min[1] + a[2] * k_min[2]
+    base -= sigma * (d0 * v0 * v0 + d1 * v1 * v1 + d2 * v2 * v2)
+    lb_energy = base + (tank.min_energy_J - energy_J) / dt if dt > 0.0 else -math.inf
+    f_max = qp.force_max_N if force_max is None else force_max
     return StiffnessQpProblem(
-        e=e,
-        e_dot=e_dot,
-        damping=damping,
-        force_ref=(float(force_ref[0]), float(force_ref[1]), float(force_ref[2])),
-        force_min=(float(force_min[0]), float(force_min[1]), float(force_min[2])),
-        force_max=tuple(qp.force_max_N)
-        if force_max is None
-        else tuple(map(float, force_max)),
-        stiffness_min=k_min,
-        stiffness_max=tuple(qp.stiffness_max_N_per_m),
-        q_weight=tuple(qp.q_weight),
-        r_weight=tuple(qp.r_weight),
-        tank_a=a,
-        tank_lb_energy=lb_energy,
-        tank_lb_power=lb_power,
+        (e0, e1, e2),
+        (v0, v1, v2),
+        (d0, d1, d2),
+        (float(force_ref[0]), float(force_ref[1]), float(force_ref[2])),
+        (float(force_min[0]), float(force_min[1]), float(force_min[2])),
+        (float(f_max[0]), float(f_max[1]), float(f_max[2])),
+        (float(k_min[0]), float(k_min[1]), float(k_min[2])),
+        tuple(qp.stiffness_max_N_per_m),
+        tuple(qp.q_weight),
+        tuple(qp.r_weight),
+        a,
+        lb_energy,
+        base + tank.power_limit_W,
     )
 
 
@@ -192,30 +195,32 @@ def stiffness_qp_violation(problem: StiffnessQpProblem, k) -> dict[str, float]:
 
 def active_constraints(problem: StiffnessQpProblem, k, *, rtol: float = 1e-6) -> int:
     """Mask of the constraints active at k, within rtol of each row's scale."""
-    p = problem
+    (e, ed, d, _, fmn, fmx, kmn, kmx, _, _, a, lb_energy, lb_power) = problem
     mask = 0
+    bit = 1
     for i in range(3):
-        kt = rtol * max(1.0, abs(p.stiffness_max[i]))
-        if k[i] - p.stiffness_min[i] <= kt:
-            mask |= 1 << (4 * i)
-        if p.stiffness_max[i] - k[i] <= kt:
-            mask |= 1 << (4 * i + 1)
-        if p.e[i] != 0.0:
-            f = p.e[i] * k[i] + p.damping[i] * p.e_dot[i]
-            ft = rtol * max(1.0, abs(p.force_max[i]), abs(p.force_min[i]))
-            if f - p.force_min[i] <= ft:
-                mask |= 1 << (4 * i + 2)
-            if p.force_max[i] - f <= ft:
-                mask |= 1 << (4 * i + 3)
-    ak = p.tank_a[0] * k[0] + p.tank_a[1] * k[1] + p.tank_a[2] * k[2]
-    scale = max(abs(p.tank_a[0]), abs(p.tank_a[1]), abs(p.tank_a[2])) * max(
-        p.stiffness_max
-    )
-    tt = rtol * max(scale, 1e-12)
-    if math.isfinite(p.tank_lb_energy) and ak - p.tank_lb_energy <= tt and scale > 0:
-        mask |= ACTIVE_TANK_ENERGY
-    if ak - p.tank_lb_power <= tt and scale > 0:
-        mask |= ACTIVE_TANK_POWER
+        ki = k[i]
+        kt = rtol * (kmx[i] if kmx[i] > 1.0 else 1.0)
+        if ki - kmn[i] <= kt:
+            mask |= bit
+        if kmx[i] - ki <= kt:
+            mask |= bit << 1
+        if e[i] != 0.0:
+            f = e[i] * ki + d[i] * ed[i]
+            ft = rtol * max(1.0, abs(fmx[i]), abs(fmn[i]))
+            if f - fmn[i] <= ft:
+                mask |= bit << 2
+            if fmx[i] - f <= ft:
+                mask |= bit << 3
+        bit <<= 4
+    ak = a[0] * k[0] + a[1] * k[1] + a[2] * k[2]
+    scale = max(abs(a[0]), abs(a[1]), abs(a[2])) * max(kmx)
+    if scale > 0.0:
+        tt = rtol * max(scale, 1e-12)
+        if ak - lb_energy <= tt:  # -inf (no dt) is never active.
+            mask |= ACTIVE_TANK_ENERGY
+        if ak - lb_power <= tt:
+            mask |= ACTIVE_TANK_POWER
     return mask
 
 
@@ -242,75 +247,79 @@ def solve_stiffness_qp_exact(
         "infeasible" when the constraints cannot all hold.
     """
     t0 = time.perf_counter()
-    p = problem
-    e, ed, d, fr = p.e, p.e_dot, p.damping, p.force_ref
-    lo = [0.0, 0.0, 0.0]
-    hi = [0.0, 0.0, 0.0]
-    lo_bit = [0, 0, 0]
-    hi_bit = [0, 0, 0]
-    free = [0.0, 0.0, 0.0]
-    curv = [0.0, 0.0, 0.0]  # 2 (Q e^2 + R): d^2 cost / dk^2.
-    for i in range(3):
-        ei = e[i]
-        kmin = p.stiffness_min[i]
-        kmax = p.stiffness_max[i]
-        q = p.q_weight[i]
-        r = p.r_weight[i]
-        dv = d[i] * ed[i]
+    (e, ed, d, fr, fmn, fmx, kmn, kmx, qw, rw, a, lb_energy, lb_power) = problem
+    lo = []
+    hi = []
+    lo_bit = []
+    hi_bit = []
+    free = []
+    curv = []  # 2 (Q e^2 + R): d^2 cost / dk^2.
+    bit = 1
+    # Per axis: the bound and force rows make one interval [lo, hi]; the
+    # unconstrained minimiser is `free`.
+    for ei, edi, di, fri, fmin, fmax, kmin, kmax, q, r in zip(
+        e, ed, d, fr, fmn, fmx, kmn, kmx, qw, rw
+    ):
+        dv = di * edi
         lo_i, hi_i = kmin, kmax
-        lb_i, hb_i = 1 << (4 * i), 1 << (4 * i + 1)
-        fmin_i, fmax_i = p.force_min[i] - dv, p.force_max[i] - dv
+        lb_i, hb_i = bit, bit << 1
+        fmin_i, fmax_i = fmin - dv, fmax - dv
         if ei > 0.0:
-            a, b = fmin_i / ei, fmax_i / ei
-            if a > lo_i:
-                lo_i, lb_i = a, 1 << (4 * i + 2)
-            if b < hi_i:
-                hi_i, hb_i = b, 1 << (4 * i + 3)
+            f_lo, f_hi = fmin_i / ei, fmax_i / ei
+            if f_lo > lo_i:
+                lo_i, lb_i = f_lo, bit << 2
+            if f_hi < hi_i:
+                hi_i, hb_i = f_hi, bit << 3
         elif ei < 0.0:
-            a, b = fmax_i / ei, fmin_i / ei
-            if a > lo_i:
-                lo_i, lb_i = a, 1 << (4 * i + 3)
-            if b < hi_i:
-                hi_i, hb_i = b, 1 << (4 * i + 2)
-        elif fmin_i > feas_tol * max(
-            1.0, abs(p.force_min[i])
-        ) or fmax_i < -feas_tol * max(1.0, abs(p.force_max[i])):
-            return _fallback(p, t0, "infeasible")
+            f_lo, f_hi = fmax_i / ei, fmin_i / ei
+            if f_lo > lo_i:
+                lo_i, lb_i = f_lo, bit << 3
+            if f_hi < hi_i:
+                hi_i, hb_i = f_hi, bit << 2
+        elif fmin_i > feas_tol * max(1.0, abs(fmin)) or fmax_i < -feas_tol * max(
+            1.0, abs(fmax)
+        ):
+            return _fallback(problem, t0, "infeasible")
         if lo_i > hi_i:
             if lo_i - hi_i > feas_tol * max(1.0, abs(hi_i)):
-                return _fallback(p, t0, "infeasible")
+                return _fallback(problem, t0, "infeasible")
             hi_i = lo_i
-        lo[i], hi[i], lo_bit[i], hi_bit[i] = lo_i, hi_i, lb_i, hb_i
+        lo.append(lo_i)
+        hi.append(hi_i)
+        lo_bit.append(lb_i)
+        hi_bit.append(hb_i)
         h = q * ei * ei + r
-        curv[i] = 2.0 * h
-        free[i] = (q * ei * (fr[i] - dv) + r * kmin) / h
+        curv.append(2.0 * h)
+        free.append((q * ei * (fri - dv) + r * kmin) / h)
+        bit <<= 4
 
-    a = p.tank_a
-    lb = p.tank_lb_energy if p.tank_lb_energy > p.tank_lb_power else p.tank_lb_power
-
-    def at(mu: float) -> tuple[list[float], float]:
-        k = [0.0, 0.0, 0.0]
-        g = 0.0
-        for i in range(3):
-            v = free[i] + mu * a[i] / curv[i]
-            k[i] = lo[i] if v < lo[i] else (hi[i] if v > hi[i] else v)
-            g += a[i] * k[i]
-        return k, g
-
-    k, g = at(0.0)
+    # mu = 0: clip the free minimiser to the box.
+    k = [
+        lo_i if v < lo_i else (hi_i if v > hi_i else v)
+        for v, lo_i, hi_i in zip(free, lo, hi)
+    ]
+    g = a[0] * k[0] + a[1] * k[1] + a[2] * k[2]
+    lb = lb_energy if lb_energy > lb_power else lb_power
     mu = 0.0
     if g < lb:
-        # The tank row is active: find mu > 0 with a' k(mu) = lb.
+        # The tank row is active. k(mu) = clip(free + mu a / curv, lo, hi) and
+        # a' k(mu) is piecewise linear and nondecreasing: walk its breakpoints.
+        def at(mu_: float) -> tuple[list[float], float]:
+            k_ = [0.0, 0.0, 0.0]
+            g_ = 0.0
+            for i in range(3):
+                v = free[i] + mu_ * a[i] / curv[i]
+                k_[i] = lo[i] if v < lo[i] else (hi[i] if v > hi[i] else v)
+                g_ += a[i] * k_[i]
+            return k_, g_
+
         best = 0.0
+        scale = 0.0
         for i in range(3):
             best += a[i] * (hi[i] if a[i] > 0.0 else lo[i])
-        scale = (
-            abs(a[0]) * max(abs(hi[0]), 1.0)
-            + abs(a[1]) * max(abs(hi[1]), 1.0)
-            + abs(a[2]) * max(abs(hi[2]), 1.0)
-        )
+            scale += abs(a[i]) * max(abs(hi[i]), 1.0)
         if best < lb - feas_tol * max(scale, abs(lb), 1e-12):
-            return _fallback(p, t0, "infeasible")
+            return _fallback(problem, t0, "infeasible")
         if best <= lb:
             mu = math.inf
             k = [
@@ -328,19 +337,18 @@ def solve_stiffness_qp_exact(
                             breaks.append(m)
             breaks.sort()
             m_prev, g_prev = 0.0, g
+            m_hit = g_hit = None
             for m in breaks:
-                k_m, g_m = at(m)
+                _, g_m = at(m)
                 if g_m >= lb:
+                    m_hit, g_hit = m, g_m
                     break
                 m_prev, g_prev = m, g_m
-            else:
-                m = None
-            if m is None:  # Only reachable by rounding: all variables clipped.
-                k, g = at(m_prev)
+            if m_hit is None:  # Only reachable by rounding: all variables clipped.
                 mu = m_prev
             else:
-                mu = m_prev + (lb - g_prev) * (m - m_prev) / (g_m - g_prev)
-                k, g = at(mu)
+                mu = m_prev + (lb - g_prev) * (m_hit - m_prev) / (g_hit - g_prev)
+            k, g = at(mu)
     active = 0
     for i in range(3):
         if k[i] <= lo[i]:
@@ -348,8 +356,8 @@ def solve_stiffness_qp_exact(
         if k[i] >= hi[i]:
             active |= hi_bit[i]
     if mu > 0.0:
-        active |= ACTIVE_TANK_ENERGY if p.tank_lb_energy >= p.tank_lb_power else 0
-        active |= ACTIVE_TANK_POWER if p.tank_lb_power >= p.tank_lb_energy else 0
+        active |= ACTIVE_TANK_ENERGY if lb_energy >= lb_power else 0
+        active |= ACTIVE_TANK_POWER if lb_power >= lb_energy else 0
     return StiffnessQpSolution(
         (k[0], k[1], k[2]), True, active, time.perf_counter() - t0, "optimal"
     )
@@ -358,9 +366,23 @@ def solve_stiffness_qp_exact(
 class StiffnessQp:
     """The stiffness QP as a Drake MathematicalProgram, built once.
 
-    Each :meth:`solve` updates the cost, the bounding box, the force rows and
-    the tank rows in place (``UpdateCoefficients`` / ``set_bounds``) and calls
-    the chosen solver. For OSQP the decision variables are k scaled per axis,
+    The program has one quadratic cost and one 8-row linear constraint
+    binding over the (scaled) stiffness kk:
+
+        rows 0-2  K_min_i <= k_i <= K_max_i             (stiffness bounds, as kk_i)
+        rows 3-5  F_min_i - D_i e_dot_i <= e_i k_i <= F_max_i - D_i e_dot_i
+        row  6    a' k >= lb_energy                     (tank energy, T+ >= T_min)
+        row  7    a' k >= lb_power                      (power valve, dT/dt >= eta)
+
+    Each :meth:`solve` updates both bindings in place (two
+    ``UpdateCoefficients`` calls; the bounds live in the same binding as the
+    rows because OSQP and Clarabel take every bound as a row anyway, and one
+    update costs ~5 us) and calls the chosen solver. A row that holds over
+    the whole box K_min <= k <= K_max is relaxed to (-inf, inf): it cannot be
+    active, and interior-point Clarabel fails on near-zero rows such as
+    1e-12 k >= c that a vanishing error produces.
+
+    Scaling. For OSQP the decision variables are k scaled per axis,
     kk_i = k_i sqrt(2 (Q_i e_i^2 + R_i)), so that the cost's Hessian is the
     identity: in N/m (or uniformly in kN/m) the curvature ranges over 1e-5
     to 1 between axes (R = 1e-5, e_i from 0 to 2 cm) and OSQP's ADMM stops
@@ -370,7 +392,8 @@ class StiffnessQp:
     N/m against the exact solver vs ~1 N/m with the per-axis scaling).
 
     Args:
-        solver: "osqp", "clarabel" or "exact" (the latter skips the program).
+        solver: "osqp", "clarabel" or "exact" (the latter skips the program
+            and calls :func:`solve_stiffness_qp_exact`).
         osqp_eps: OSQP's eps_abs and eps_rel.
     """
 
@@ -390,13 +413,17 @@ class StiffnessQp:
         if solver == "exact":
             return
         prog = MathematicalProgram()
-        kk = prog.NewContinuousVariables(3, "k_kN_per_m")
+        kk = prog.NewContinuousVariables(3, "k_scaled")
         self._prog = prog
         self._cost = prog.AddQuadraticCost(np.eye(3), np.zeros(3), kk, is_convex=True)
-        self._box = prog.AddBoundingBoxConstraint(np.zeros(3), np.ones(3), kk)
-        self._force = prog.AddLinearConstraint(np.eye(3), -np.ones(3), np.ones(3), kk)
-        self._tank = prog.AddLinearConstraint(
-            np.ones((2, 3)), np.full(2, -np.inf), np.full(2, np.inf), kk
+        self._rows = prog.AddLinearConstraint(
+            np.vstack([np.eye(3), np.eye(3), np.ones((2, 3))]),
+            np.full(8, -np.inf),
+            np.full(8, np.inf),
+            kk,
+        )
+        self._rows.evaluator().set_description(
+            "stiffness bounds, force rows, tank rows"
         )
         self._options = SolverOptions()
         if solver == "osqp":
@@ -423,10 +450,7 @@ class StiffnessQp:
             )
         self._unit_hessian = solver == "osqp"
         self._Q = np.zeros((3, 3))
-        self._b = np.zeros(3)
-        self._A_force = np.zeros((3, 3))
-        self._A_tank = np.zeros((2, 3))
-        self._guess = np.zeros(3)
+        self._A = np.zeros((8, 3))
 
     @property
     def prog(self):
@@ -438,69 +462,52 @@ class StiffnessQp:
         if self.solver_name == "exact":
             return solve_stiffness_qp_exact(problem)
         t0 = time.perf_counter()
-        p = problem
-        Q, b, A_f, A_t = self._Q, self._b, self._A_force, self._A_tank
-        lb_f = np.empty(3)
-        ub_f = np.empty(3)
-        lb_k = np.empty(3)
-        ub_k = np.empty(3)
-        scale = [1.0, 1.0, 1.0]
+        (e, ed, d, fr, fmn, fmx, kmn, kmx, qw, rw, a, lb_energy, lb_power) = problem
+        inf = math.inf
+        Q, A = self._Q, self._A
+        lb = [0.0] * 8
+        ub = [0.0] * 8
+        b = [0.0, 0.0, 0.0]
+        scale = [1e3, 1e3, 1e3]
+        a_low = 0.0  # min of a' k over the box.
         for i in range(3):
-            e = p.e[i]
-            h = p.q_weight[i] * e * e + p.r_weight[i]
-            dv = p.damping[i] * p.e_dot[i]
-            # cost_i = h k^2 - 2 (Q e (F_ref - D e_dot) + R K_min) k + const. With
-            # k = s kk and s = 1 / sqrt(2 h) the Hessian in kk is the identity.
+            ei = e[i]
+            h = qw[i] * ei * ei + rw[i]
+            dv = d[i] * ed[i]
+            # cost_i = h k^2 - 2 (Q e (F_ref - D e_dot) + R K_min) k + const, k = s kk.
             s = 1.0 / math.sqrt(2.0 * h) if self._unit_hessian else 1e3
             scale[i] = s
             Q[i, i] = 2.0 * h * s * s
-            b[i] = (
-                -2.0
-                * (
-                    p.q_weight[i] * e * (p.force_ref[i] - dv)
-                    + p.r_weight[i] * p.stiffness_min[i]
-                )
-                * s
-            )
-            lb_f[i] = p.force_min[i] - dv
-            ub_f[i] = p.force_max[i] - dv
-            f_lo = e * (p.stiffness_min[i] if e > 0.0 else p.stiffness_max[i])
-            f_hi = e * (p.stiffness_max[i] if e > 0.0 else p.stiffness_min[i])
-            if lb_f[i] <= f_lo and f_hi <= ub_f[i]:
-                # Redundant over the whole box: drop it. Interior-point solvers
-                # fail on rows like 1e-12 k >= c that a small e produces.
-                A_f[i, i], lb_f[i], ub_f[i] = 0.0, -np.inf, np.inf
+            b[i] = -2.0 * (qw[i] * ei * (fr[i] - dv) + rw[i] * kmn[i]) * s
+            A[i, i] = 1.0
+            lb[i], ub[i] = kmn[i] / s, kmx[i] / s
+            f_lo_row, f_hi_row = fmn[i] - dv, fmx[i] - dv
+            f_lo = ei * (kmn[i] if ei > 0.0 else kmx[i])
+            f_hi = ei * (kmx[i] if ei > 0.0 else kmn[i])
+            if f_lo_row <= f_lo and f_hi <= f_hi_row:  # Redundant over the box.
+                A[3 + i, i], lb[3 + i], ub[3 + i] = 0.0, -inf, inf
             else:
-                A_f[i, i] = e * s
-            lb_k[i] = p.stiffness_min[i] / s
-            ub_k[i] = p.stiffness_max[i] / s
-            A_t[0, i] = A_t[1, i] = p.tank_a[i] * s
-        if not self._unit_hessian:  # Normalise (the scale does not move the optimum).
+                A[3 + i, i], lb[3 + i], ub[3 + i] = ei * s, f_lo_row, f_hi_row
+            A[6, i] = A[7, i] = a[i] * s
+            a_low += a[i] * (kmn[i] if a[i] > 0.0 else kmx[i])
+        lb[6] = lb_energy if lb_energy > a_low else -inf
+        lb[7] = lb_power if lb_power > a_low else -inf
+        ub[6] = ub[7] = inf
+        if self._unit_hessian:
+            self._cost.evaluator().UpdateCoefficients(Q, np.array(b))
+        else:  # Normalise (the scale does not move the optimum).
             c = 1.0 / max(Q[0, 0], Q[1, 1], Q[2, 2])
-            Q *= c
-            b *= c
-        self._cost.evaluator().UpdateCoefficients(Q, b)
-        self._box.evaluator().set_bounds(lb_k, ub_k)
-        self._force.evaluator().UpdateCoefficients(A_f, lb_f, ub_f)
-        # The tank rows share a' k; drop each one that holds over the whole box.
-        a_low = 0.0
-        for i in range(3):
-            a_i = p.tank_a[i]
-            a_low += a_i * (p.stiffness_min[i] if a_i > 0.0 else p.stiffness_max[i])
-        lb_t = np.array(
-            [
-                p.tank_lb_energy if p.tank_lb_energy > a_low else -np.inf,
-                p.tank_lb_power if p.tank_lb_power > a_low else -np.inf,
-            ]
-        )
-        self._tank.evaluator().UpdateCoefficients(A_t, lb_t, np.full(2, np.inf))
+            self._cost.evaluator().UpdateCoefficients(Q * c, np.array(b) * c)
+        self._rows.evaluator().UpdateCoefficients(A, np.array(lb), np.array(ub))
         result = self._solver.Solve(self._prog, None, self._options)
         if not result.is_success():
-            return _fallback(p, t0, str(result.get_solution_result()).split(".")[-1])
+            return _fallback(
+                problem, t0, str(result.get_solution_result()).split(".")[-1]
+            )
         kk = result.get_x_val()
         k = (float(kk[0]) * scale[0], float(kk[1]) * scale[1], float(kk[2]) * scale[2])
-        if not all(math.isfinite(v) for v in k):
-            return _fallback(p, t0, "non_finite")
+        if not (math.isfinite(k[0]) and math.isfinite(k[1]) and math.isfinite(k[2])):
+            return _fallback(problem, t0, "non_finite")
         return StiffnessQpSolution(
-            k, True, active_constraints(p, k), time.perf_counter() - t0, "optimal"
+            k, True, active_constraints(problem, k), time.perf_counter() - t0, "optimal"
         )

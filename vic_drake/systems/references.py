@@ -22,6 +22,7 @@ from vic_drake.control.references import (
     in_contact,
     penetration,
     penetration_rate,
+    scalar_sampler,
     surface_velocity_gradient,
     surface_velocity_initial_state,
     surface_velocity_step,
@@ -58,6 +59,7 @@ class ForceReferenceSystem(LeafSystem):
         params.validate()
         self._params = params
         self._phantom = phantom
+        self._sample = scalar_sampler(phantom)
         self._dt = float(params.period_s)
         ref = params.reference
         self._mode = ref.surface_velocity_mode
@@ -107,20 +109,17 @@ class ForceReferenceSystem(LeafSystem):
             values[3:6] = (qp.force_min_N[0], qp.force_min_N[1], -qp.force_max_N[2])
             values[11] = 1.0
             return values, filt
-        sample = self._phantom.sample(p_WP[0], p_WP[1])
-        surface_z = float(sample.surface_z_m)
+        surface_z, dz_dx, dz_dy, kappa, lam = self._sample(p_WP[0], p_WP[1])
         if self._mode == "moving_average":
             new_filt, z_surf_dot = surface_velocity_step(filt, surface_z, self._dt)
         else:
             new_filt = filt
-            z_surf_dot = surface_velocity_gradient(
-                float(sample.dz_dx), float(sample.dz_dy), v_WP[0], v_WP[1]
-            )
+            z_surf_dot = surface_velocity_gradient(dz_dx, dz_dy, v_WP[0], v_WP[1])
         contact = in_contact(f_W[2], ref)
         refs = force_references(
             contact=contact,
-            kappa=float(sample.kappa),
-            lam=float(sample.lam),
+            kappa=kappa,
+            lam=lam,
             eps_dot=penetration_rate(v_WP[2], z_surf_dot),
             beta=self._phantom.beta,
             ref=ref,

@@ -1,0 +1,181 @@
+"""Per-tick cost of the online controller (reference + stiffness QP + tank).
+
+Prints median and p99 wall time per tick, in microseconds, against the
+2,000 us of a 500 Hz loop, for
+
+- the pure functions of one tick (phantom lookup, references, QP, tank),
+  with the exact solver and through the MathematicalProgram (OSQP,
+  Clarabel);
+- the Drake Diagram ``MakeVariableImpedanceController`` advanced by a
+  Simulator (inputs fixed, 500 Hz events of its three LeafSystems), the same
+  three solvers.
+
+The inputs replay the real log ``test_nardi_matForce_lowR`` (VS-VF) when the
+data is present, else a synthetic scan. Goals (issue): p99 <= 200 us through
+the MathematicalProgram, <= 30 us exact. No asserts: this prints figures.
+
+Usage:
+    python benchmarks/bench_controller.py [--ticks N] [--phantom synthetic|measured]
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+
+import numpy as np
+
+from vic_drake.control.params import (
+    ControllerParams,
+    ReferenceParams,
+    StiffnessQpParams,
+)
+from vic_drake.control.references import (
+    force_references,
+    in_contact,
+    penetration_rate,
+    scalar_sampler,
+    surface_velocity_initial_state,
+    surface_velocity_step,
+)
+from vic_drake.control.stiffness_qp import StiffnessQp, make_stiffness_qp_problem
+from vic_drake.control.tank import tank_step
+from vic_drake.paths import has_data, resolve_data_dir
+from vic_drake.tissue.phantom import load_phantom
+
+LOOP_US = 2000.0
+
+
+def inputs(n: int, phantom):
+    """(p_WP, v_WP, x_d, f_W) rows: the real VS-VF log, else a synthetic scan."""
+    if has_data():
+        from vic_drake.realdata import read_bag
+
+        df = read_bag(resolve_data_dir() / "experiments" / "test_nardi_matForce_lowR")
+        df = df.iloc[: min(n, len(df))]
+        p = df[["x_m", "y_m", "z_m"]].to_numpy()
+        v = df[["vx_m_per_s", "vy_m_per_s", "vz_m_per_s"]].to_numpy()
+        xd = df[["x_d_m", "y_d_m", "z_d_m"]].to_numpy()
+        f = df[["sensor_force_x_N", "sensor_force_y_N", "sensor_force_z_N"]].to_numpy()
+        return "log test_nardi_matForce_lowR", p, v, xd, f
+    t = np.arange(n) * 0.002
+    x0, x1, y0, y1 = phantom.bounds
+    x = 0.5 * (x0 + x1) - 0.01 * t
+    y = np.full(n, 0.5 * (y0 + y1))
+    zs = np.asarray(phantom.surface_z(x, y), float)
+    p = np.column_stack([x, y, zs - 0.005 - 0.001 * np.sin(2 * np.pi * t)])
+    v = np.column_stack(
+        [np.full(n, -0.01), np.zeros(n), -0.002 * np.pi * np.cos(2 * np.pi * t)]
+    )
+    xd = np.column_stack([x - 0.002, y, zs - 0.015])
+    f = np.column_stack([np.zeros(n), np.zeros(n), np.full(n, -7.0)])
+    return "synthetic scan", p, v, xd, f
+
+
+def stats(samples_s) -> str:
+    us = np.asarray(samples_s) * 1e6
+    med, p99 = np.median(us), np.percentile(us, 99)
+    return f"median {med:8.1f} us  p99 {p99:8.1f} us  ({100 * p99 / LOOP_US:5.1f}% of 2 ms)"
+
+
+def bench_functions(params: ControllerParams, phantom, rows, solver: str):
+    """One tick of the pure functions, as the LeafSystems chain them."""
+    ref, qp, tank = params.reference, params.qp, params.tank
+    dt = params.period_s
+    sample = scalar_sampler(phantom)
+    qp_solver = StiffnessQp(solver, osqp_eps=qp.osqp_eps)
+    k_min = tuple(qp.stiffness_min_N_per_m)
+    filt = surface_velocity_initial_state(ref.surface_velocity_window)
+    energy, k_prev = tank.initial_energy_J, k_min
+    zeta = qp.damping_ratio
+    times, qp_times = [], []
+    p_all, v_all, xd_all, f_all = (r.tolist() for r in rows)
+    for p, v, xd, f in zip(p_all, v_all, xd_all, f_all):
+        t0 = time.perf_counter()
+        surface_z, _, _, kappa, lam = sample(p[0], p[1])
+        filt, z_surf_dot = surface_velocity_step(filt, surface_z, dt)
+        contact = in_contact(f[2], ref)
+        refs = force_references(
+            contact=contact, kappa=kappa, lam=lam, eps_dot=penetration_rate(v[2], z_surf_dot),
+            beta=phantom.beta, ref=ref, qp=qp,
+        )  # fmt: skip
+        e = (xd[0] - p[0], xd[1] - p[1], xd[2] - p[2])
+        e_dot = (-v[0], -v[1], -v[2])
+        d = (2 * zeta * math.sqrt(k_prev[0]), 2 * zeta * math.sqrt(k_prev[1]),
+             2 * zeta * math.sqrt(k_prev[2]))  # fmt: skip
+        t1 = time.perf_counter()
+        if energy >= tank.min_energy_J:
+            problem = make_stiffness_qp_problem(
+                e, e_dot, d, refs.force_ref, refs.force_min, energy, dt, qp, tank
+            )
+            k = qp_solver.solve(problem).stiffness
+        else:
+            k = k_min
+        t2 = time.perf_counter()
+        energy = tank_step(energy, e, e_dot, k, k_min, d, dt, tank).energy_J
+        k_prev = k
+        t3 = time.perf_counter()
+        times.append(t3 - t0)
+        qp_times.append(t2 - t1)
+    return times, qp_times
+
+
+def bench_diagram(params: ControllerParams, phantom, rows, ticks: int):
+    """The Diagram advanced by a Simulator, one period at a time."""
+    from pydrake.systems.analysis import Simulator
+
+    from vic_drake.systems.controller import MakeVariableImpedanceController
+
+    diagram = MakeVariableImpedanceController(params, phantom=phantom)
+    simulator = Simulator(diagram)
+    context = simulator.get_mutable_context()
+    ports = [diagram.GetInputPort(n) for n in
+             ("ee_position", "ee_velocity", "target_position", "measured_force")]  # fmt: skip
+    p_all, v_all, xd_all, f_all = rows
+    simulator.Initialize()
+    times = []
+    for i in range(min(ticks, len(p_all))):
+        for port, values in zip(ports, (p_all[i], v_all[i], xd_all[i], f_all[i])):
+            port.FixValue(context, values)
+        t0 = time.perf_counter()
+        simulator.AdvanceTo((i + 1) * params.period_s)
+        diagram.GetOutputPort("stiffness").Eval(context)
+        times.append(time.perf_counter() - t0)
+    return times
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--ticks", type=int, default=5000)
+    parser.add_argument("--diagram-ticks", type=int, default=2000)
+    parser.add_argument("--phantom", choices=("synthetic", "measured"), default=None)
+    args = parser.parse_args()
+    kind = args.phantom or ("measured" if has_data() else "synthetic")
+    phantom = load_phantom(kind)
+    source, *rows = inputs(args.ticks, phantom)
+    print(
+        f"inputs: {source}, {len(rows[0])} ticks; phantom: {kind}; loop budget {LOOP_US:.0f} us"
+    )
+    print("-- pure functions, one tick = phantom lookup + references + QP + tank")
+    for solver in ("exact", "osqp", "clarabel"):
+        params = ControllerParams(
+            qp=StiffnessQpParams(r_weight=[1e-5] * 3, solver=solver),
+            reference=ReferenceParams(controller="vs-vf"),
+        )
+        total, qp_only = bench_functions(params, phantom, rows, solver)
+        print(f"{solver:9s} tick  {stats(total)}")
+        print(f"{solver:9s} QP    {stats(qp_only)}")
+    print("-- Diagram (3 LeafSystems, Simulator.AdvanceTo one period per tick)")
+    for solver in ("exact", "osqp", "clarabel"):
+        params = ControllerParams(
+            qp=StiffnessQpParams(r_weight=[1e-5] * 3, solver=solver),
+            reference=ReferenceParams(controller="vs-vf"),
+        )
+        print(
+            f"{solver:9s} tick  {stats(bench_diagram(params, phantom, rows, args.diagram_ticks))}"
+        )
+
+
+if __name__ == "__main__":
+    main()
