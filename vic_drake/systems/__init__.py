@@ -1,0 +1,1 @@
+"""Thin Drake LeafSystems and diagram builders wrapping vic_drake's pure functions."""

@@ -1,0 +1,552 @@
+"""A bank of 1-DOF indenters palpating tissue: the palpation campaign's diagram.
+
+Each indenter is a body on a vertical prismatic joint of a discrete
+:class:`MultibodyPlant`, driven by the plant's implicit joint PD controller
+towards a desired state (the position servo of the real Cartesian
+controller, with gravity compensated by a feed-forward force). The tissue
+pushes back through :class:`HuntCrossleyIndentation`, a thin LeafSystem
+calling :func:`vic_drake.tissue.hunt_crossley_force` (the same function the
+full robot's force element uses) with each indenter's surface height, kappa,
+lambda and beta. :class:`LaggedForceSensor` samples the force the sensor sees
+(tissue force minus the inertia of the indenter below it) at 500 Hz, adds
+Gaussian noise and delays it by a fixed number of samples, as the real F/T
+sensor does. :class:`PalpationTarget` runs the procedure of the real rig:
+descend at constant speed until the measured force exceeds a threshold,
+record the height, then track a sinusoid a set depth below that height.
+
+Many indenters share one diagram (one joint each, every LeafSystem
+vectorised over them), so a whole campaign costs one simulation: the
+per-step Python overhead is paid once for all points, not once per point.
+Per-indenter data (surface height, kappa, lambda, start height) are numeric
+parameters in the Context, so one built diagram is reused for any batch of
+points by writing a fresh Context.
+
+Force convention: every force here is positive when the body pushes the
+indenter up (minus the F/T sensor's z reading).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from pydrake.common import RandomDistribution, RandomGenerator
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.multibody.tree import (
+    PdControllerGains,
+    PrismaticJoint,
+    SpatialInertia,
+    UnitInertia,
+)
+from pydrake.systems.framework import BasicVector, Diagram, DiagramBuilder, LeafSystem
+from pydrake.systems.primitives import (
+    ConstantVectorSource,
+    LogVectorOutput,
+    RandomSource,
+)
+
+from vic_drake.errors import VicDrakeError
+from vic_drake.tissue import hunt_crossley_force
+
+GRAVITY_M_PER_S2 = 9.81
+
+
+def _check_positive(owner: str, **values) -> None:
+    for name, value in values.items():
+        if not (np.isfinite(value) and value > 0):
+            raise VicDrakeError(
+                f"{owner}.{name} must be a finite number > 0, got {value!r}"
+            )
+
+
+@dataclass(frozen=True)
+class IndenterParams:
+    """The indenter and its position servo.
+
+    The servo gains were identified from the real palpation logs
+    (``palpation/test_soft_{1,2,25}hz``): the real Cartesian controller held
+    the tip 8.4-9.9 mm deep under 5-6 N with a target 15 mm deep (a static
+    stiffness of about 1000 N/m against the tissue's), and the tip moved with
+    0.35, 0.16 and 0.12 of the target's 8 mm amplitude at 1, 2 and 2.5 Hz,
+    which a damping of about 400 N s/m reproduces. The real controller's
+    compliance keeps the penetration rate low, which keeps the fit in the
+    regime where the Hunt-Crossley force stays compressive.
+    """
+
+    moving_mass_kg: float = 2.0  # Mass the servo moves (effective end-effector mass).
+    indenter_mass_kg: float = (
+        0.081  # Mass below the F/T sensing element (BOTA wrench side).
+    )
+    servo_stiffness_N_per_m: float = 1000.0  # Position gain of the joint PD servo.
+    servo_damping_N_s_per_m: float = 400.0  # Velocity gain of the joint PD servo.
+    time_step_s: float = 0.001  # Discrete MultibodyPlant step.
+
+    def __post_init__(self):
+        _check_positive(
+            "IndenterParams",
+            moving_mass_kg=self.moving_mass_kg,
+            servo_stiffness_N_per_m=self.servo_stiffness_N_per_m,
+            servo_damping_N_s_per_m=self.servo_damping_N_s_per_m,
+            time_step_s=self.time_step_s,
+        )
+        if not (
+            np.isfinite(self.indenter_mass_kg)
+            and 0 <= self.indenter_mass_kg <= self.moving_mass_kg
+        ):
+            raise VicDrakeError(
+                "IndenterParams.indenter_mass_kg must be in [0, moving_mass_kg], got "
+                f"{self.indenter_mass_kg!r}"
+            )
+
+
+@dataclass(frozen=True)
+class SensorParams:
+    """The F/T sensor model, from the real palpation logs.
+
+    ``noise_std_N``: the std of the real z force about a Savitzky-Golay
+    smoothing (31 samples, cubic) in contact is 0.046 N in all three
+    palpation logs (0.041 N with an 11-sample window); the 32-37 free-air
+    samples before contact scatter by 0.06-0.09 N including the onset of
+    contact. ``lag_samples``: the real controller delayed the pose by 28
+    samples to align it with the force (data README), i.e. 56 ms at 500 Hz.
+    """
+
+    rate_hz: float = 500.0  # Sampling rate (the UR3e control rate).
+    lag_samples: int = 28  # Force delay behind the pose, samples.
+    noise_std_N: float = 0.045  # White Gaussian noise on the force, N.
+    bias_N: float = 0.0  # Constant tare error, N (the real logs: -0.35 to 0.08 N).
+
+    def __post_init__(self):
+        _check_positive("SensorParams", rate_hz=self.rate_hz)
+        if int(self.lag_samples) != self.lag_samples or self.lag_samples < 0:
+            raise VicDrakeError(
+                f"SensorParams.lag_samples must be an integer >= 0, got {self.lag_samples!r}"
+            )
+        if not (np.isfinite(self.noise_std_N) and self.noise_std_N >= 0):
+            raise VicDrakeError(
+                f"SensorParams.noise_std_N must be >= 0, got {self.noise_std_N!r}"
+            )
+        if not np.isfinite(self.bias_N):
+            raise VicDrakeError(
+                f"SensorParams.bias_N must be finite, got {self.bias_N!r}"
+            )
+
+    @property
+    def period_s(self) -> float:
+        return 1.0 / self.rate_hz
+
+
+@dataclass(frozen=True)
+class PalpationParams:
+    """One sinusoidal palpation, as on the real rig (paper Sec. IV-A)."""
+
+    depth_m: float = 0.015  # Mean target depth below the detected surface.
+    amplitude_m: float = 0.008  # Target sinusoid amplitude.
+    frequency_hz: float = 2.5  # Target sinusoid frequency.
+    duration_s: float = 5.0  # Palpation length after contact.
+    start_clearance_m: float = 0.003  # Start height above the true surface.
+    approach_speed_m_per_s: float = 0.02  # Descent speed before contact.
+    contact_threshold_N: float = (
+        0.5  # Measured force that ends the approach (real: 0.5 N).
+    )
+    max_approach_s: float = 1.0  # Give-up time for the approach.
+    # Feed the target velocity to the servo. The real Cartesian controller
+    # did not (its damping acted on the tip velocity, see IndenterParams).
+    velocity_feedforward: bool = False
+
+    def __post_init__(self):
+        _check_positive(
+            "PalpationParams",
+            depth_m=self.depth_m,
+            frequency_hz=self.frequency_hz,
+            duration_s=self.duration_s,
+            approach_speed_m_per_s=self.approach_speed_m_per_s,
+            contact_threshold_N=self.contact_threshold_N,
+            max_approach_s=self.max_approach_s,
+        )
+        if not (np.isfinite(self.amplitude_m) and 0 <= self.amplitude_m < self.depth_m):
+            raise VicDrakeError(
+                "PalpationParams.amplitude_m must be in [0, depth_m) so the target stays "
+                f"below the surface, got {self.amplitude_m!r}"
+            )
+        if not (np.isfinite(self.start_clearance_m) and self.start_clearance_m >= 0):
+            raise VicDrakeError(
+                "PalpationParams.start_clearance_m must be >= 0, got "
+                f"{self.start_clearance_m!r}"
+            )
+
+
+def palpation_target(t, mode, z_start, z_contact, t_contact, params: PalpationParams):
+    """Desired height and velocity of every indenter at time t (vectorised).
+
+    Approach (mode 0): descend from z_start at the approach speed. Palpation
+    (mode 1): ``z_contact - depth - amplitude sin(2 pi f (t - t_contact))``.
+    The desired velocity is the target's derivative with
+    ``params.velocity_feedforward``, else zero.
+
+    Returns:
+        (z_d, v_d): arrays like ``mode``.
+    """
+    w = 2 * np.pi * params.frequency_hz
+    tau = t - t_contact
+    z_app = z_start - params.approach_speed_m_per_s * t
+    v_app = np.full_like(z_app, -params.approach_speed_m_per_s)
+    z_pal = z_contact - params.depth_m - params.amplitude_m * np.sin(w * tau)
+    v_pal = -params.amplitude_m * w * np.cos(w * tau)
+    palpating = mode > 0.5
+    v_d = np.where(palpating, v_pal, v_app)
+    if not params.velocity_feedforward:
+        v_d = np.zeros_like(v_d)
+    return np.where(palpating, z_pal, z_app), v_d
+
+
+class HuntCrossleyIndentation(LeafSystem):
+    """Hunt-Crossley tissue force on n vertical indenters.
+
+    Input ``indenter_state`` (2n: heights q in m, velocities v in m/s).
+    Output ``generalized_force`` (n, N, positive up): the force applied to
+    each joint, ``hunt_crossley_force(s - q, -v, kappa, lambda, beta,
+    clip_tension=True)``. Numeric parameters (n each): ``surface_z``,
+    ``kappa``, ``lambda`` (set with :meth:`set_tissue`).
+    """
+
+    def __init__(self, n: int, beta: float):
+        super().__init__()
+        _check_positive("HuntCrossleyIndentation", beta=beta)
+        self._n = int(n)
+        self._beta = float(beta)
+        self._surface_index = self.DeclareNumericParameter(BasicVector(np.zeros(n)))
+        self._kappa_index = self.DeclareNumericParameter(BasicVector(np.ones(n)))
+        self._lam_index = self.DeclareNumericParameter(BasicVector(np.zeros(n)))
+        self._state_port = self.DeclareVectorInputPort("indenter_state", 2 * n)
+        self._force_port = self.DeclareVectorOutputPort(
+            "generalized_force", n, self._calc_force
+        )
+
+    def get_indenter_state_input_port(self):
+        return self._state_port
+
+    def get_generalized_force_output_port(self):
+        return self._force_port
+
+    @property
+    def beta(self) -> float:
+        return self._beta
+
+    def set_tissue(self, context, *, surface_z, kappa, lam) -> None:
+        """Writes the tissue under each indenter into this system's context."""
+        for index, value in (
+            (self._surface_index, surface_z),
+            (self._kappa_index, kappa),
+            (self._lam_index, lam),
+        ):
+            context.get_mutable_numeric_parameter(index).SetFromVector(
+                np.broadcast_to(np.asarray(value, float), (self._n,))
+            )
+
+    def _calc_force(self, context, output):
+        x = self._state_port.Eval(context)
+        q, v = x[: self._n], x[self._n :]
+        s = context.get_numeric_parameter(self._surface_index).get_value()
+        kappa = context.get_numeric_parameter(self._kappa_index).get_value()
+        lam = context.get_numeric_parameter(self._lam_index).get_value()
+        output.SetFromVector(
+            hunt_crossley_force(s - q, -v, kappa, lam, self._beta, clip_tension=True)
+        )
+
+
+def sensed_force(
+    tissue_force, acceleration, noise, *, indenter_mass_kg, noise_std_N, bias_N
+):
+    """What the tared F/T sensor reads (positive up): F - m_I a + noise + bias."""
+    return tissue_force - indenter_mass_kg * acceleration + noise_std_N * noise + bias_N
+
+
+class LaggedForceSensor(LeafSystem):
+    """A tared F/T sensor on n indenters: sampled, noisy and delayed.
+
+    Inputs: ``tissue_force`` (n, N), ``acceleration`` (n, m/s^2),
+    ``noise`` (n, unit Gaussian samples, e.g. from a RandomSource).
+    Output: ``measured_force`` (n, N, positive up), the reading of
+    ``lag_samples`` periods ago. The delay line is discrete state.
+    """
+
+    def __init__(self, n: int, params: SensorParams, *, indenter_mass_kg: float):
+        super().__init__()
+        self._n = int(n)
+        self._params = params
+        self._mass = float(indenter_mass_kg)
+        self._depth = int(params.lag_samples) + 1
+        self._tissue_port = self.DeclareVectorInputPort("tissue_force", n)
+        self._acc_port = self.DeclareVectorInputPort("acceleration", n)
+        self._noise_port = self.DeclareVectorInputPort("noise", n)
+        # Row k of the (depth, n) delay line is the reading of k periods ago.
+        self._buffer = self.DeclareDiscreteState(self._depth * n)
+        self.DeclarePeriodicDiscreteUpdateEvent(params.period_s, 0.0, self._update)
+        self._output_port = self.DeclareVectorOutputPort(
+            "measured_force",
+            n,
+            self._calc_output,
+            {self.discrete_state_ticket(self._buffer)},
+        )
+
+    def get_measured_force_output_port(self):
+        return self._output_port
+
+    def _update(self, context, discrete_state):
+        buffer = (
+            context.get_discrete_state(self._buffer)
+            .get_value()
+            .reshape(self._depth, self._n)
+        )
+        reading = sensed_force(
+            self._tissue_port.Eval(context),
+            self._acc_port.Eval(context),
+            self._noise_port.Eval(context),
+            indenter_mass_kg=self._mass,
+            noise_std_N=self._params.noise_std_N,
+            bias_N=self._params.bias_N,
+        )
+        shifted = np.vstack([reading[None, :], buffer[:-1]])
+        discrete_state.get_mutable_vector(self._buffer).SetFromVector(shifted.ravel())
+
+    def _calc_output(self, context, output):
+        buffer = context.get_discrete_state(self._buffer).get_value()
+        output.SetFromVector(buffer[-self._n :])
+
+
+class PalpationTarget(LeafSystem):
+    """The palpation procedure of the real rig, for n indenters.
+
+    Input ``measured_force`` (n, N) and ``indenter_state`` (2n). Discrete
+    state (updated at the sensor rate): per indenter the mode (0 approach,
+    1 palpation), the height and the time at which the measured force first
+    exceeded the contact threshold. Output ``desired_state`` (2n: heights,
+    velocities), see :func:`palpation_target`. Numeric parameter
+    ``start_z`` (n): the height each approach starts from.
+    """
+
+    def __init__(self, n: int, params: PalpationParams, *, period_s: float):
+        super().__init__()
+        self._n = int(n)
+        self._params = params
+        self._start_index = self.DeclareNumericParameter(BasicVector(np.zeros(n)))
+        self._force_port = self.DeclareVectorInputPort("measured_force", n)
+        self._state_port = self.DeclareVectorInputPort("indenter_state", 2 * n)
+        self._mode = self.DeclareDiscreteState(np.zeros(3 * n))
+        self.DeclarePeriodicDiscreteUpdateEvent(period_s, 0.0, self._update)
+        self._desired_port = self.DeclareVectorOutputPort(
+            "desired_state",
+            2 * n,
+            self._calc_desired,
+            {
+                self.time_ticket(),
+                self.discrete_state_ticket(self._mode),
+                self.all_parameters_ticket(),
+            },
+        )
+        self._contact_port = self.DeclareStateOutputPort("contact", self._mode)
+
+    def get_desired_state_output_port(self):
+        return self._desired_port
+
+    def get_contact_output_port(self):
+        """(3n): mode, contact height (m), contact time (s) per indenter."""
+        return self._contact_port
+
+    def set_start_z(self, context, start_z) -> None:
+        context.get_mutable_numeric_parameter(self._start_index).SetFromVector(
+            np.broadcast_to(np.asarray(start_z, float), (self._n,))
+        )
+
+    def _update(self, context, discrete_state):
+        n = self._n
+        state = context.get_discrete_state(self._mode).get_value().reshape(3, n).copy()
+        mode, z_c, t_c = state
+        force = self._force_port.Eval(context)
+        q = self._state_port.Eval(context)[:n]
+        t = context.get_time()
+        hit = (mode < 0.5) & (force > self._params.contact_threshold_N)
+        mode[hit], z_c[hit], t_c[hit] = 1.0, q[hit], t
+        discrete_state.get_mutable_vector(self._mode).SetFromVector(state.ravel())
+
+    def _calc_desired(self, context, output):
+        n = self._n
+        mode, z_c, t_c = (
+            context.get_discrete_state(self._mode).get_value().reshape(3, n)
+        )
+        z0 = context.get_numeric_parameter(self._start_index).get_value()
+        z_d, v_d = palpation_target(
+            context.get_time(), mode, z0, z_c, t_c, self._params
+        )
+        output.SetFromVector(np.concatenate([z_d, v_d]))
+
+
+@dataclass
+class IndenterBank:
+    """Handles of a built indenter diagram (see :func:`MakeIndenterDiagram`)."""
+
+    diagram: Diagram
+    plant: MultibodyPlant
+    tissue: HuntCrossleyIndentation
+    sensor: LaggedForceSensor
+    target: PalpationTarget
+    state_logger: object
+    force_logger: object
+    target_logger: object
+    contact_logger: object
+    n: int
+
+    def set_points(
+        self, root_context, *, surface_z, kappa, lam, start_z, seed=None
+    ) -> None:
+        """Writes the tissue and the start height of every indenter.
+
+        The indenters start at rest at ``start_z``; arrays of shape (n,).
+        With ``seed``, the sensor noise is reseeded first (this resets every
+        random state and parameter, hence it comes before the writes).
+        """
+        if seed is not None:
+            self.diagram.SetRandomContext(root_context, RandomGenerator(int(seed)))
+        self.tissue.set_tissue(
+            self.tissue.GetMyMutableContextFromRoot(root_context),
+            surface_z=surface_z,
+            kappa=kappa,
+            lam=lam,
+        )
+        self.target.set_start_z(
+            self.target.GetMyMutableContextFromRoot(root_context), start_z
+        )
+        plant_context = self.plant.GetMyMutableContextFromRoot(root_context)
+        self.plant.SetPositionsAndVelocities(
+            plant_context,
+            np.concatenate([np.broadcast_to(start_z, (self.n,)), np.zeros(self.n)]),
+        )
+
+
+def MakeIndenterDiagram(
+    n: int,
+    *,
+    beta: float,
+    indenter: IndenterParams | None = None,
+    sensor: SensorParams | None = None,
+    palpation: PalpationParams | None = None,
+) -> IndenterBank:
+    """Builds n servo-driven 1-DOF indenters palpating Hunt-Crossley tissue.
+
+    Args:
+        n: number of indenters (one prismatic joint each).
+        beta: Hunt-Crossley exponent of the tissue.
+        indenter, sensor, palpation: parameters (defaults as documented).
+
+    Returns:
+        An :class:`IndenterBank`; loggers sample at the sensor rate:
+        ``state_logger`` (2n: q, v), ``force_logger`` (n, measured force,
+        N), ``target_logger`` (2n: z_d, v_d), ``contact_logger`` (3n).
+    """
+    if int(n) != n or n < 1:
+        raise VicDrakeError(f"number of indenters must be an integer >= 1, got {n!r}")
+    n = int(n)
+    indenter = indenter or IndenterParams()
+    sensor = sensor or SensorParams()
+    palpation = palpation or PalpationParams()
+
+    builder = DiagramBuilder()
+    plant = builder.AddNamedSystem(
+        "plant", MultibodyPlant(time_step=indenter.time_step_s)
+    )
+    instance = plant.AddModelInstance("indenters")
+    inertia = SpatialInertia(
+        indenter.moving_mass_kg, np.zeros(3), UnitInertia.SolidSphere(0.02)
+    )
+    gains = PdControllerGains(
+        p=indenter.servo_stiffness_N_per_m, d=indenter.servo_damping_N_s_per_m
+    )
+    for i in range(n):
+        body = plant.AddRigidBody(f"indenter_{i}", instance, inertia)
+        joint = plant.AddJoint(
+            PrismaticJoint(
+                f"indenter_{i}_z",
+                plant.world_frame(),
+                body.body_frame(),
+                [0.0, 0.0, 1.0],
+            )
+        )
+        actuator = plant.AddJointActuator(f"indenter_{i}_servo", joint)
+        actuator.set_controller_gains(gains)
+    plant.Finalize()
+
+    tissue = builder.AddNamedSystem("tissue", HuntCrossleyIndentation(n, beta))
+    force_sensor = builder.AddNamedSystem(
+        "ft_sensor",
+        LaggedForceSensor(n, sensor, indenter_mass_kg=indenter.indenter_mass_kg),
+    )
+    noise = builder.AddNamedSystem(
+        "sensor_noise", RandomSource(RandomDistribution.kGaussian, n, sensor.period_s)
+    )
+    target = builder.AddNamedSystem(
+        "palpation_target", PalpationTarget(n, palpation, period_s=sensor.period_s)
+    )
+    gravity_compensation = builder.AddNamedSystem(
+        "gravity_compensation",
+        ConstantVectorSource(np.full(n, indenter.moving_mass_kg * GRAVITY_M_PER_S2)),
+    )
+
+    state_port = plant.get_state_output_port(instance)
+    builder.Connect(state_port, tissue.get_indenter_state_input_port())
+    builder.Connect(
+        tissue.get_generalized_force_output_port(),
+        plant.get_applied_generalized_force_input_port(),
+    )
+    builder.Connect(
+        tissue.get_generalized_force_output_port(),
+        force_sensor.GetInputPort("tissue_force"),
+    )
+    builder.Connect(
+        plant.get_generalized_acceleration_output_port(instance),
+        force_sensor.GetInputPort("acceleration"),
+    )
+    builder.Connect(noise.get_output_port(0), force_sensor.GetInputPort("noise"))
+    builder.Connect(
+        force_sensor.get_measured_force_output_port(),
+        target.GetInputPort("measured_force"),
+    )
+    builder.Connect(state_port, target.GetInputPort("indenter_state"))
+    builder.Connect(
+        target.get_desired_state_output_port(),
+        plant.get_desired_state_input_port(instance),
+    )
+    builder.Connect(
+        gravity_compensation.get_output_port(), plant.get_actuation_input_port(instance)
+    )
+
+    period = sensor.period_s
+    state_logger = LogVectorOutput(state_port, builder, period)
+    force_logger = LogVectorOutput(
+        force_sensor.get_measured_force_output_port(), builder, period
+    )
+    target_logger = LogVectorOutput(
+        target.get_desired_state_output_port(), builder, period
+    )
+    contact_logger = LogVectorOutput(target.get_contact_output_port(), builder, period)
+    for logger, name in (
+        (state_logger, "state_logger"),
+        (force_logger, "force_logger"),
+        (target_logger, "target_logger"),
+        (contact_logger, "contact_logger"),
+    ):
+        logger.set_name(name)
+    diagram = builder.Build()
+    diagram.set_name("indenter_bank")
+    return IndenterBank(
+        diagram=diagram,
+        plant=plant,
+        tissue=tissue,
+        sensor=force_sensor,
+        target=target,
+        state_logger=state_logger,
+        force_logger=force_logger,
+        target_logger=target_logger,
+        contact_logger=contact_logger,
+        n=n,
+    )
