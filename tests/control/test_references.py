@@ -94,3 +94,43 @@ def test_surface_velocity_moving_average():
     assert surface_velocity_gradient(0.1, -0.2, 0.01, 0.02) == pytest.approx(
         0.001 - 0.004
     )
+
+
+@pytest.mark.parametrize("lookup", ["bilinear", "nearest"])
+def test_scalar_sampler_equals_phantom_sample(lookup):
+    import numpy as np
+
+    from vic_drake.control.references import scalar_sampler
+    from vic_drake.tissue.phantom import GridPhantom
+
+    rng = np.random.default_rng(7)
+    x = np.cumsum(rng.uniform(0.5e-3, 2e-3, 12))
+    y = np.cumsum(rng.uniform(0.5e-3, 2e-3, 9)) - 0.4
+    shape = (x.size, y.size)
+    phantom = GridPhantom(
+        x_m=x, y_m=y, z_m=rng.uniform(0.08, 0.12, shape), kappa=rng.uniform(2e3, 1e4, shape),
+        lam=rng.uniform(2e4, 2e5, shape), surface_offset_m=0.0025, lookup=lookup,
+    )  # fmt: skip
+    sample = scalar_sampler(phantom)
+    qx = np.concatenate(
+        [rng.uniform(x[0] - 0.005, x[-1] + 0.005, 400), x, [x[0], x[-1]]]
+    )
+    qy = np.concatenate(
+        [
+            rng.uniform(y[0] - 0.005, y[-1] + 0.005, 400),
+            y[:1].repeat(x.size),
+            [y[-1], y[0]],
+        ]
+    )
+    for xi, yi in zip(qx, qy):
+        s = phantom.sample(xi, yi)
+        expected = [
+            float(s.surface_z_m),
+            float(s.dz_dx),
+            float(s.dz_dy),
+            float(s.kappa),
+            float(s.lam),
+        ]
+        assert sample(float(xi), float(yi)) == pytest.approx(
+            expected, rel=1e-13, abs=1e-15
+        )
