@@ -119,3 +119,54 @@ def test_sensor_lags_the_tissue_force_by_the_set_samples(phantom):
     lags = range(0, 50)
     err = [np.sum((f_ft[k:] - f_hc[: len(f_hc) - k]) ** 2) for k in lags]
     assert abs(int(np.argmin(err)) - 28) <= 1
+
+
+def test_phantom_volume_mesh_is_valid_and_follows_the_surface(phantom):
+    from vic_drake.models.phantom_mesh import boundary_triangles, phantom_volume_mesh
+
+    vertices, tets = phantom_volume_mesh(phantom, resolution_m=0.03, thickness_m=0.05)
+    a, b, c, d = (vertices[tets[:, i]] for i in range(4))
+    volumes = np.einsum("ij,ij->i", np.cross(b - a, c - a), d - a) / 6
+    assert np.all(volumes > 0)
+    x_min, x_max, y_min, y_max = phantom.bounds
+    top = vertices[np.isclose(vertices[:, 2], phantom.surface_z(vertices[:, 0], vertices[:, 1]))]
+    assert len(top) >= ((x_max - x_min) / 0.03) * ((y_max - y_min) / 0.03)
+    # The slab's volume is the integral of its height.
+    footprint = (x_max - x_min) * (y_max - y_min)
+    # (the grid mean of the height weights the edges like the interior: ~3 %)
+    assert volumes.sum() == pytest.approx(footprint * (np.mean(top[:, 2]) - vertices[:, 2].min()),
+                                          rel=0.05)
+    # A closed boundary: every edge of the surface is shared by two faces.
+    faces = boundary_triangles(vertices, tets)
+    edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
+    _, counts = np.unique(edges, axis=0, return_counts=True)
+    assert np.all(counts == 2)
+
+
+def test_links_meet_the_phantom_but_the_indenter_does_not(phantom):
+    """Kinematically push the tool 9 cm into the phantom: the sensor housing
+    (7 cm above the tip) meets the compliant mesh; the indenter never does."""
+    params = StationParams()
+    station = MakeStation(params, phantom=phantom)
+    context = station.CreateDefaultContext()
+    s = float(phantom.surface_z(*XY))
+    q = initial_q_for_tip([*XY, s - 0.09], params)
+    station.GetInputPort("ur3e.position_command").FixValue(context, q)
+    station.GetInputPort("phantom.lift").FixValue(context, [0.0])
+    from vic_drake.station import set_station_state, station_plant
+
+    set_station_state(station, context, q)
+    plant = station_plant(station)
+    # The plant's output ports are sampled: take one step to fill them.
+    Simulator(station, context).AdvanceTo(params.time_step_s)
+    contacts = station.GetOutputPort("plant.contact_results").Eval(context)
+    assert contacts.num_hydroelastic_contacts() >= 1
+    inspector = station.GetSubsystemByName("scene_graph").model_inspector()
+    touching = set()
+    for i in range(contacts.num_hydroelastic_contacts()):
+        surface = contacts.hydroelastic_contact_info(i).contact_surface()
+        for gid in (surface.id_M(), surface.id_N()):
+            touching.add(plant.GetBodyFromFrameId(inspector.GetFrameId(gid)).name())
+    assert "phantom" in touching
+    assert "indenter" not in touching
+    assert touching & {"ft_sensor_wrench", "ft_sensor_mount"}

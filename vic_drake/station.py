@@ -99,7 +99,7 @@ from pydrake.systems.primitives import (
 )
 
 from vic_drake.errors import VicDrakeError
-from vic_drake.models.phantom_mesh import phantom_vtk_path
+from vic_drake.models.phantom_mesh import phantom_mesh_paths
 from vic_drake.systems.ft_sensor import ForceTorqueSensor
 from vic_drake.systems.tissue_force import TissueForceElement
 from vic_drake.tissue import Phantom
@@ -605,7 +605,7 @@ def _add_phantom(plant, params: StationParams, phantom: Phantom):
     actuator.set_controller_gains(
         PdControllerGains(p=params.phantom_kp_N_per_m, d=params.phantom_kd_Ns_per_m)
     )
-    vtk = phantom_vtk_path(
+    vtk, obj = phantom_mesh_paths(
         phantom, resolution_m=params.phantom_mesh_resolution_m,
         thickness_m=params.phantom_thickness_m,
     )
@@ -621,7 +621,7 @@ def _add_phantom(plant, params: StationParams, phantom: Phantom):
         body, RigidTransform(), Mesh(str(vtk)), "phantom_collision", props
     )
     plant.RegisterVisualGeometry(
-        body, RigidTransform(), Mesh(str(vtk)), "phantom_visual", [0.9, 0.75, 0.65, 1.0]
+        body, RigidTransform(), Mesh(str(obj)), "phantom_visual", [0.9, 0.75, 0.65, 1.0]
     )
     return model, body, geometry
 

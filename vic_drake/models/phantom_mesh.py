@@ -118,6 +118,39 @@ def write_vtk(path: str | os.PathLike, vertices: np.ndarray, tets: np.ndarray) -
     return path
 
 
+def boundary_triangles(vertices: np.ndarray, tets: np.ndarray) -> np.ndarray:
+    """The tetrahedral mesh's boundary faces (m, 3), normals pointing outwards."""
+    faces, opposite = [], []
+    for skip in range(4):
+        keep = [i for i in range(4) if i != skip]
+        faces.append(tets[:, keep])
+        opposite.append(tets[:, skip])
+    faces = np.concatenate(faces)
+    opposite = np.concatenate(opposite)
+    key = np.sort(faces, axis=1)
+    _, index, counts = np.unique(key, axis=0, return_index=True, return_counts=True)
+    faces, opposite = faces[index[counts == 1]], opposite[index[counts == 1]]
+    a, b, c = (vertices[faces[:, i]] for i in range(3))
+    normal = np.cross(b - a, c - a)
+    inward = np.einsum("ij,ij->i", normal, vertices[opposite] - a) > 0
+    faces[inward, 1], faces[inward, 2] = faces[inward, 2].copy(), faces[inward, 1].copy()
+    return faces
+
+
+def write_obj(path: str | os.PathLike, vertices: np.ndarray, triangles: np.ndarray) -> Path:
+    """Writes a triangle surface as Wavefront OBJ (for visualization)."""
+    path = Path(path)
+    used = np.unique(triangles)
+    remap = np.full(len(vertices), -1)
+    remap[used] = np.arange(len(used))
+    lines = [f"v {x:.9g} {y:.9g} {z:.9g}" for x, y, z in vertices[used]]
+    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in remap[triangles]]
+    tmp = path.with_suffix(f".{os.getpid()}.tmp")
+    tmp.write_text("\n".join(lines) + "\n")
+    tmp.replace(path)
+    return path
+
+
 def cache_dir() -> Path:
     """Folder for generated model files ($VIC_DRAKE_CACHE or the temp dir)."""
     root = os.environ.get("VIC_DRAKE_CACHE")
@@ -126,17 +159,23 @@ def cache_dir() -> Path:
     return base
 
 
-def phantom_vtk_path(phantom: Phantom, *, resolution_m: float, thickness_m: float) -> Path:
-    """Writes (or reuses) the phantom's volume mesh and returns its .vtk path.
+def phantom_mesh_paths(
+    phantom: Phantom, *, resolution_m: float, thickness_m: float
+) -> tuple[Path, Path]:
+    """Writes (or reuses) the phantom's meshes: (volume .vtk, boundary .obj).
 
-    The file name hashes the mesh's vertices and tetrahedra, so a changed
-    phantom or setting never reuses a stale file.
+    The .vtk is the compliant hydroelastic geometry, the .obj its boundary
+    for visualization (Meshcat draws no .vtk). File names hash the mesh, so
+    a changed phantom or setting never reuses a stale file.
     """
     vertices, tets = phantom_volume_mesh(
         phantom, resolution_m=resolution_m, thickness_m=thickness_m
     )
     digest = hashlib.sha1(vertices.tobytes() + tets.tobytes()).hexdigest()[:16]
-    path = cache_dir() / f"phantom_{phantom.name}_{digest}.vtk"
-    if not path.is_file():
-        write_vtk(path, vertices, tets)
-    return path
+    vtk = cache_dir() / f"phantom_{phantom.name}_{digest}.vtk"
+    obj = vtk.with_suffix(".obj")
+    if not vtk.is_file():
+        write_vtk(vtk, vertices, tets)
+    if not obj.is_file():
+        write_obj(obj, vertices, boundary_triangles(vertices, tets))
+    return vtk, obj
