@@ -72,8 +72,7 @@ def MakeVariableImpedanceController(
     builder.ExportInput(qp.GetInputPort("target_position"), "target_position")
     builder.ExportInput(ref.GetInputPort("measured_force"), "measured_force")
 
-    for name in ("force_reference", "force_min", "contact"):
-        builder.Connect(ref.GetOutputPort(name), qp.GetInputPort(name))
+    builder.Connect(ref.GetOutputPort("references"), qp.GetInputPort("references"))
     builder.Connect(tank.get_energy_output_port(), qp.GetInputPort("tank_energy"))
     builder.Connect(qp.get_commit_output_port(), tank.get_commit_input_port())
 

@@ -30,10 +30,6 @@ from vic_drake.control.references import (
 from vic_drake.tissue.phantom import Phantom
 
 
-def _finite3(v) -> bool:
-    return math.isfinite(v[0]) and math.isfinite(v[1]) and math.isfinite(v[2])
-
-
 class ForceReferenceSystem(LeafSystem):
     """Force references of the selected controller (CS, CF, VS-CF, VS-VF).
 
@@ -48,6 +44,9 @@ class ForceReferenceSystem(LeafSystem):
         target_force (3): force the FDCC stage tracks, N (CF only).
         contact (4): [in_contact (0/1), penetration_m, fault (0/1),
             surface_velocity_m_per_s].
+        references (13): all of the above in that order (force_reference,
+            force_min, target_force, contact), read by StiffnessQpSystem in
+            one port evaluation.
 
     State: the surface-velocity filter (discrete, updated every period).
     A non-finite input gives F_ref = 0, F_min = (F_min,x, F_min,y,
@@ -83,6 +82,7 @@ class ForceReferenceSystem(LeafSystem):
             ("force_min", 3, 3),
             ("target_force", 3, 6),
             ("contact", 4, 9),
+            ("references", 13, 0),
         ):
             self._outputs[name] = self.DeclareVectorOutputPort(
                 name,
@@ -99,12 +99,13 @@ class ForceReferenceSystem(LeafSystem):
 
     def _evaluate(self, context):
         """(values (13,), new filter state) for the current inputs."""
-        p_WP = self._position_port.Eval(context)
-        v_WP = self._velocity_port.Eval(context)
-        f_W = self._force_port.Eval(context)
-        filt = context.get_discrete_state(self._filter_index).value()
+        p_WP = self._position_port.Eval(context).tolist()
+        v_WP = self._velocity_port.Eval(context).tolist()
+        f_W = self._force_port.Eval(context).tolist()
+        filt = context.get_discrete_state(self._filter_index).value().tolist()
         ref, qp = self._params.reference, self._params.qp
-        if not (_finite3(p_WP) and _finite3(v_WP) and _finite3(f_W)):
+        # A sum of floats is finite iff every term is (inf - inf = nan).
+        if not math.isfinite(sum(p_WP) + sum(v_WP) + sum(f_W)):
             values = np.zeros(13)
             values[3:6] = (qp.force_min_N[0], qp.force_min_N[1], -qp.force_max_N[2])
             values[11] = 1.0
@@ -125,21 +126,20 @@ class ForceReferenceSystem(LeafSystem):
             ref=ref,
             qp=qp,
         )
-        values = np.array(
-            [
-                *refs.force_ref,
-                *refs.force_min,
-                *refs.target_force,
-                1.0 if contact else 0.0,
-                penetration(surface_z, p_WP[2]),
-                0.0,
-                z_surf_dot,
-            ]
-        )
-        if not np.all(np.isfinite(values)):  # E.g. a phantom returning NaN.
-            values[:] = 0.0
+        values = [
+            *refs.force_ref,
+            *refs.force_min,
+            *refs.target_force,
+            1.0 if contact else 0.0,
+            penetration(surface_z, p_WP[2]),
+            0.0,
+            z_surf_dot,
+        ]
+        if not math.isfinite(sum(values)):  # E.g. a phantom returning NaN.
+            values = [0.0] * 13
             values[3:6] = (qp.force_min_N[0], qp.force_min_N[1], -qp.force_max_N[2])
             values[11] = 1.0
+        values = np.array(values)
         return values, new_filt
 
     def _calc(self, context, value):

@@ -31,10 +31,6 @@ STATUS_FIELDS = (
 )
 
 
-def _finite(v) -> bool:
-    return all(math.isfinite(x) for x in v)
-
-
 class StiffnessQpSystem(LeafSystem):
     """Diagonal stiffness from the QP of eq. 8 (or CS/CF's constant one).
 
@@ -42,9 +38,9 @@ class StiffnessQpSystem(LeafSystem):
         ee_position (3): p_WP, m.
         ee_velocity (3): v_WP, m/s.
         target_position (3): x_d, m.
-        force_reference (3): F_ref, N. force_min (3): F_min, N.
-        contact (4): [in_contact, penetration_m, fault, surface_velocity]
-            from ForceReferenceSystem.
+        references (13): ForceReferenceSystem's "references": [F_ref (3, N),
+            F_min (3, N), target force (3, N), in_contact, penetration_m,
+            fault, surface_velocity_m_per_s].
         tank_energy (1): T before this tick, J (EnergyTankSystem "energy").
 
     Output ports:
@@ -83,9 +79,7 @@ class StiffnessQpSystem(LeafSystem):
             ("ee_position", 3),
             ("ee_velocity", 3),
             ("target_position", 3),
-            ("force_reference", 3),
-            ("force_min", 3),
-            ("contact", 4),
+            ("references", 13),
             ("tank_energy", 1),
         ):
             ports[name] = self.DeclareVectorInputPort(name, size)
@@ -119,16 +113,14 @@ class StiffnessQpSystem(LeafSystem):
 
     def _update(self, context, discrete_state):
         inp = self._in
-        p_WP = inp["ee_position"].Eval(context)
-        v_WP = inp["ee_velocity"].Eval(context)
-        x_d = inp["target_position"].Eval(context)
-        f_ref = inp["force_reference"].Eval(context)
-        f_min = inp["force_min"].Eval(context)
-        contact = inp["contact"].Eval(context)
+        p_WP = inp["ee_position"].Eval(context).tolist()
+        v_WP = inp["ee_velocity"].Eval(context).tolist()
+        x_d = inp["target_position"].Eval(context).tolist()
+        refs = inp["references"].Eval(context).tolist()
         energy = float(inp["tank_energy"].Eval(context)[0])
-        commit_old = context.get_discrete_state(self._commit_index).value()
-        status_old = context.get_discrete_state(self._status_index).value()
-        count = status_old[1]
+        commit_old = context.get_discrete_state(self._commit_index).value().tolist()
+        count = context.get_discrete_state(self._status_index).GetAtIndex(1)
+        f_ref, f_min = refs[0:3], refs[3:6]
         zeta = self._zeta
         k_prev = commit_old[6:9]
         d_used = (
@@ -136,18 +128,9 @@ class StiffnessQpSystem(LeafSystem):
             2.0 * zeta * math.sqrt(max(k_prev[1], 0.0)),
             2.0 * zeta * math.sqrt(max(k_prev[2], 0.0)),
         )
-        fault = (
-            not (
-                _finite(p_WP)
-                and _finite(v_WP)
-                and _finite(x_d)
-                and _finite(f_ref)
-                and _finite(f_min)
-                and _finite(contact)
-                and math.isfinite(energy)
-            )
-            or contact[2] > 0.5
-        )
+        # A sum of floats is finite iff every term is (inf - inf = nan).
+        total = sum(p_WP) + sum(v_WP) + sum(x_d) + sum(refs) + energy
+        fault = not math.isfinite(total) or refs[11] > 0.5
         e = (0.0, 0.0, 0.0)
         e_dot = (0.0, 0.0, 0.0)
         qp_ok, solve_time = 1.0, 0.0
@@ -177,8 +160,8 @@ class StiffnessQpSystem(LeafSystem):
         commit = discrete_state.get_mutable_vector(self._commit_index)
         commit.SetFromVector([*e, *e_dot, *k, *d_used, self._dt, active])
         status = discrete_state.get_mutable_vector(self._status_index)
-        in_contact = 0.0 if fault else float(contact[0])
-        pen = float(contact[1]) if math.isfinite(contact[1]) else 0.0
+        in_contact = 0.0 if fault else refs[9]
+        pen = refs[10] if math.isfinite(refs[10]) else 0.0
         status.SetFromVector(
             [qp_ok, count, 1.0 if fault else 0.0, in_contact, solve_time, pen]
         )
