@@ -249,3 +249,44 @@ def test_values_mutated_after_construction_are_checked(phantom):
                   lambda: ForceReferenceSystem(params, phantom=phantom)):  # fmt: skip
         with pytest.raises(VicDrakeError, match=r"stiffness_min_N_per_m\[2\] = 2000.0"):
             build()
+
+
+@pytest.fixture(scope="module")
+def sloped():
+    """Tissue surface z = 0.10 + 0.2 x (slope 0.2 along x), uniform kappa, lambda."""
+    x = np.array([-1.0, 1.0])
+    z = 0.10 + 0.2 * np.array([[-1.0, -1.0], [1.0, 1.0]])
+    ones = np.ones((2, 2))
+    return GridPhantom(
+        x_m=x, y_m=x, z_m=z, kappa=KAPPA * ones, lam=LAM * ones, beta=BETA
+    )
+
+
+def test_surface_velocity_moving_average_in_the_system(sloped):
+    params, diagram, context = make(sloped, "vs-cf")
+    tick(diagram, context)  # Records the height under P_WP.
+    p2 = P_WP + np.array([-0.001, 0.0, 0.0])  # 1 mm along -x: surface 0.2 mm lower.
+    diagram.GetInputPort("ee_position").FixValue(context, p2)
+    ref = diagram.GetSubsystemByName("force_reference")
+    contact = ref.get_contact_output_port().Eval(ref.GetMyContextFromRoot(context))
+    z_rate = (0.2 * -0.001) / 0.002  # One finite difference, averaged over 10 samples.
+    assert contact[3] == pytest.approx(z_rate / 10, rel=1e-9)
+    eps_dot = contact[3] - V_WP[2]
+    f_min_z = -(KAPPA + LAM * eps_dot) * 0.008**BETA
+    assert out(diagram, context, "force_min")[2] == pytest.approx(f_min_z, rel=1e-12)
+
+
+def test_surface_velocity_gradient_mode(sloped):
+    params = ControllerParams(
+        reference=ReferenceParams(controller="vs-vf", surface_velocity_mode="gradient")
+    )
+    diagram = MakeVariableImpedanceController(params, phantom=sloped)
+    context = diagram.CreateDefaultContext()
+    for name, value in (("ee_position", P_WP), ("ee_velocity", V_WP), ("target_position", X_D),
+                        ("measured_force", F_W)):  # fmt: skip
+        diagram.GetInputPort(name).FixValue(context, value)
+    eps_dot = 0.2 * V_WP[0] - V_WP[2]  # grad z . v minus z_dot.
+    f_ref_z = -(KAPPA + LAM * eps_dot) * 0.008**BETA
+    assert out(diagram, context, "force_reference")[2] == pytest.approx(
+        f_ref_z, rel=1e-12
+    )
