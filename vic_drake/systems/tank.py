@@ -19,7 +19,6 @@ from vic_drake.control.params import ControllerParams
 from vic_drake.control.tank import (
     TankStep,
     tank_energy,
-    tank_sigma,
     tank_state,
     tank_step,
 )
@@ -77,12 +76,12 @@ class EnergyTankSystem(LeafSystem):
         energy = tank_energy(
             context.get_discrete_state(self._state_index).GetAtIndex(0)
         )
-        c = self._commit_port.Eval(context)
+        c = self._commit_port.Eval(context).tolist()
         if c[COMMIT_ACTIVE] < 0.5:
             return TankStep(energy, 0.0, 0.0, False)
         return tank_step(
             energy, c[COMMIT_E], c[COMMIT_E_DOT], c[COMMIT_K], self._k_min, c[COMMIT_D],
-            float(c[COMMIT_DT]), self._tank,
+            c[COMMIT_DT], self._tank,
         )  # fmt: skip
 
     def _calc_tank(self, context, output: BasicVector):
@@ -91,17 +90,14 @@ class EnergyTankSystem(LeafSystem):
             [s.energy_J, s.power_W, s.sigma, 1.0 if s.enabled else 0.0]
         )
 
+    # "energy" and the update read the cached "tank" output: one tank step per tick.
     def _calc_energy(self, context, output: BasicVector):
-        output.SetAtIndex(0, self._step(context).energy_J)
+        output.SetAtIndex(0, self._tank_port.Eval(context)[0])
 
     def _update(self, context, discrete_state):
         discrete_state.get_mutable_vector(self._state_index).SetAtIndex(
-            0, tank_state(self._step(context).energy_J)
+            0, tank_state(float(self._tank_port.Eval(context)[0]))
         )
-
-    def sigma(self, context) -> float:
-        """sigma for the next tick (from the tank energy after the commit)."""
-        return tank_sigma(self._step(context).energy_J, self._tank)
 
     def get_commit_input_port(self):
         return self._commit_port
