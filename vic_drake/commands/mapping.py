@@ -78,7 +78,8 @@ def register(subparsers) -> None:
         "--region",
         default=None,
         metavar="X0,X1,Y0,Y1",
-        help="region to palpate and map, m, base frame (default: the measured map's grid; "
+        help="region to palpate and map, m, base frame; write --region=X0,... when X0 is "
+        "negative (default: the measured map's grid; "
         "for the synthetic phantom the central 20 x 10 cm the paper palpated)",
     )
     parser.add_argument(

@@ -51,6 +51,12 @@ class GpMapParams:
         length_scale_bounds_m: bounds of the length scales.
         noise_level_bounds: bounds of the WhiteKernel variance (in units of
             the normalised target, i.e. a fraction of its variance).
+        min_length_scale_spacing: the lower length-scale bound is raised to
+            this fraction of the median nearest-neighbour spacing of the data:
+            a field varying faster than half the sampling spacing is not
+            identifiable from the samples, and without this bound a few
+            points across a rib let the fit collapse to a length scale of
+            1 mm (a map that is the mean everywhere between the points).
         n_restarts: optimiser restarts from random hyperparameters.
         chunk_size: grid points predicted per chunk.
         seed: seed of the restarts.
@@ -61,6 +67,7 @@ class GpMapParams:
     length_scale_m: float = 0.02
     length_scale_bounds_m: tuple[float, float] = (1e-3, 0.5)
     noise_level_bounds: tuple[float, float] = (1e-6, 1.0)
+    min_length_scale_spacing: float = 0.5
     n_restarts: int = 3
     chunk_size: int = 50_000
     seed: int = 0
@@ -81,6 +88,14 @@ class GpMapParams:
             raise VicDrakeError(
                 f"GpMapParams.noise_level_bounds must be 0 < lo < hi, got {self.noise_level_bounds!r}"
             )
+        if not (
+            np.isfinite(self.min_length_scale_spacing)
+            and self.min_length_scale_spacing >= 0
+        ):
+            raise VicDrakeError(
+                "GpMapParams.min_length_scale_spacing must be >= 0, got "
+                f"{self.min_length_scale_spacing!r}"
+            )
         if int(self.n_restarts) != self.n_restarts or self.n_restarts < 0:
             raise VicDrakeError(
                 f"GpMapParams.n_restarts must be an integer >= 0, got {self.n_restarts!r}"
@@ -91,16 +106,32 @@ class GpMapParams:
             )
 
 
-def make_kernel(params: GpMapParams):
-    """ConstantKernel * (RBF | Matern)(anisotropic) + WhiteKernel."""
-    ls = [params.length_scale_m, params.length_scale_m]
+def nearest_neighbour_spacing(x, y) -> float:
+    """Median distance from each point to its nearest neighbour, m."""
+    from scipy.spatial import cKDTree
+
+    pts = np.column_stack([np.asarray(x, float), np.asarray(y, float)])
+    if len(pts) < 2:
+        return 0.0
+    d, _ = cKDTree(pts).query(pts, k=2)
+    return float(np.median(d[:, 1]))
+
+
+def make_kernel(params: GpMapParams, *, min_length_scale_m: float = 0.0):
+    """ConstantKernel * (RBF | Matern)(anisotropic) + WhiteKernel.
+
+    ``min_length_scale_m`` raises the lower length-scale bound (see
+    GpMapParams.min_length_scale_spacing).
+    """
+    lo, hi = params.length_scale_bounds_m
+    lo = min(max(lo, min_length_scale_m), 0.5 * hi)
+    start = float(np.clip(params.length_scale_m, lo, hi))
+    ls = [start, start]
     if params.kernel == "rbf":
-        shape = RBF(length_scale=ls, length_scale_bounds=params.length_scale_bounds_m)
+        shape = RBF(length_scale=ls, length_scale_bounds=(lo, hi))
     else:
         shape = Matern(
-            length_scale=ls,
-            length_scale_bounds=params.length_scale_bounds_m,
-            nu=params.matern_nu,
+            length_scale=ls, length_scale_bounds=(lo, hi), nu=params.matern_nu
         )
     return ConstantKernel(1.0, (1e-3, 1e3)) * shape + WhiteKernel(
         1e-2, noise_level_bounds=params.noise_level_bounds
@@ -124,7 +155,11 @@ def fit_gp(x, y, values, params: GpMapParams | None = None) -> GaussianProcessRe
     if x.size < 3:
         raise VicDrakeError(f"fit_gp needs at least 3 points, got {x.size}")
     gp = GaussianProcessRegressor(
-        kernel=make_kernel(params),
+        kernel=make_kernel(
+            params,
+            min_length_scale_m=params.min_length_scale_spacing
+            * nearest_neighbour_spacing(x, y),
+        ),
         normalize_y=True,
         n_restarts_optimizer=int(params.n_restarts),
         random_state=int(params.seed),
