@@ -66,11 +66,19 @@ def test_wrong_r_is_visible(logs):
     assert s["kz_abs_err_max"] > 10.0  # The replay discriminates R.
 
 
-def test_logged_constants_must_match_parameters(logs):
+def test_logged_settings_are_used_and_reported(logs):
+    df = logs["test_tracking5"].copy()
+    result = replay_controller_log(
+        df, ControllerParams(tank=TankParams(min_energy_J=0.3))
+    )
+    assert result.from_log == {"stiffness_z_min_N_per_m": 100.0, "stiffness_z_max_N_per_m": 1000.0,
+                               "tank_min_J": 0.4, "power_limit_W": 0.1}  # fmt: skip
+    assert (
+        result.summary()["kz_abs_err_max"] <= 1e-9
+    )  # The log's T_min, not 0.3, was used.
+    df.loc[5, "tank_min_J"] = 0.3
     with pytest.raises(VicDrakeError, match="tank_min_J"):
-        replay_controller_log(
-            logs["test_tracking5"], ControllerParams(tank=TankParams(min_energy_J=0.3))
-        )
+        replay_controller_log(df)
 
 
 def test_replay_qp_command_json(data_dir, capsys):

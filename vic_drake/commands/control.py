@@ -55,7 +55,9 @@ def run_replay_qp(args: argparse.Namespace) -> int:
         f"{summary['ticks']} ticks, |K_z error| median {summary['kz_abs_err_median']:.3g}, "
         f"p99 {summary['kz_abs_err_p99']:.3g}, max {summary['kz_abs_err_max']:.3g} N/m; "
         f"tank |error| max {summary['tank_abs_err_max_J']:.3g} J; "
-        f"{summary['failures']} failed solves"
+        f"{summary['failures']} failed solves\n"
+        "settings read from the log: "
+        + ", ".join(f"{k} = {v:g}" for k, v in result.from_log.items())
     )
     emit(summary, args.json, human)
     return 0

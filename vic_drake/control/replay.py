@@ -18,9 +18,11 @@ one, then step the tank from the logged T of row i-1 with our K and compare
 with the logged T of row i. Ticks with T < T_min use K = K_min, as the real
 controller did. R is not logged: it must be given (0.1 for test_tracking5,
 1e-5 for test_nardi_matForce_lowR); the default of
-:class:`StiffnessQpParams` is 0.1. The constants that are logged (K_z
-bounds, T_min, power limit) are checked against the parameters and a
-mismatch is an error, never silently replaced.
+:class:`StiffnessQpParams` is 0.1. The settings the controller logged every
+tick (K_z bounds, T_min, power limit) are its inputs too: they are read from
+the log (a column that varies is an error) and reported in
+``ReplayResult.from_log``; the others (Q, K_min and K_max on x and y, F_max,
+F_min on x and y, zeta, T_max) come from the parameters.
 """
 
 from __future__ import annotations
@@ -52,6 +54,8 @@ class ReplayResult:
         solve_time_s: (m,) solve times.
         solver: solver name.
         r_weight: R used on every axis.
+        from_log: the settings read from the log's constant columns (K_z
+            bounds, T_min, power limit), which override the parameters.
     """
 
     t_s: np.ndarray
@@ -63,6 +67,7 @@ class ReplayResult:
     solve_time_s: np.ndarray
     solver: str
     r_weight: float
+    from_log: dict
 
     def summary(self) -> dict:
         """The ``replay-qp`` JSON record."""
@@ -78,13 +83,19 @@ class ReplayResult:
         }
 
 
-def _check_logged_constant(df: pd.DataFrame, column: str, value: float, what: str):
-    logged = df[column].to_numpy()
-    if not np.allclose(logged, value, rtol=1e-9, atol=1e-12):
+def _logged_constant(df: pd.DataFrame, column: str) -> float:
+    """The value of a column the controller logged as a constant setting."""
+    logged = df[column].to_numpy(dtype=float)
+    value = float(logged[0])
+    if not (
+        np.all(np.isfinite(logged))
+        and np.allclose(logged, value, rtol=1e-9, atol=1e-12)
+    ):
         raise VicDrakeError(
-            f"log column {column!r} holds {np.unique(logged)[:5].tolist()} but the replay "
-            f"parameters have {what} = {value!r}; set the parameter to the logged value"
+            f"log column {column!r} should hold one setting for the whole run; it holds "
+            f"{np.unique(logged)[:5].tolist()}... (a replay of a varying setting is not supported)"
         )
+    return value
 
 
 def replay_controller_log(
@@ -107,8 +118,7 @@ def replay_controller_log(
 
     Raises:
         VicDrakeError: wrong layout, fewer than 2 rows, non-finite inputs, or
-            logged constants (K_z min/max, T_min, power limit) that differ
-            from the parameters.
+            a logged setting (K_z min/max, T_min, power limit) that varies.
     """
     params = ControllerParams() if params is None else params
     qp = params.qp
@@ -127,16 +137,28 @@ def replay_controller_log(
         )
     if len(df) < 2:
         raise VicDrakeError(f"replay needs at least 2 rows; the log has {len(df)}")
-    _check_logged_constant(
-        df, "stiffness_z_min_N_per_m", qp.stiffness_min_N_per_m[2], "K_min,z"
-    )
-    _check_logged_constant(
-        df, "stiffness_z_max_N_per_m", qp.stiffness_max_N_per_m[2], "K_max,z"
-    )
-    _check_logged_constant(df, "tank_min_J", tank.min_energy_J, "T_min")
-    _check_logged_constant(
-        df, "power_limit_W", -tank.power_limit_W, "-eta (power limit)"
-    )
+    # Settings the controller logged every tick override the parameters, and
+    # are reported in ReplayResult.from_log (so nothing is inferred silently).
+    from_log = {
+        "stiffness_z_min_N_per_m": _logged_constant(df, "stiffness_z_min_N_per_m"),
+        "stiffness_z_max_N_per_m": _logged_constant(df, "stiffness_z_max_N_per_m"),
+        "tank_min_J": _logged_constant(df, "tank_min_J"),
+        "power_limit_W": _logged_constant(df, "power_limit_W"),
+    }
+    try:
+        k_lo, k_hi = list(qp.stiffness_min_N_per_m), list(qp.stiffness_max_N_per_m)
+        k_lo[2] = from_log["stiffness_z_min_N_per_m"]
+        k_hi[2] = from_log["stiffness_z_max_N_per_m"]
+        qp = replace(qp, stiffness_min_N_per_m=k_lo, stiffness_max_N_per_m=k_hi)
+        tank = replace(
+            tank,
+            min_energy_J=from_log["tank_min_J"],
+            power_limit_W=-from_log["power_limit_W"],
+        )
+    except VicDrakeError as exc:
+        raise VicDrakeError(
+            f"the log's logged settings are not a valid controller: {exc}"
+        ) from exc
 
     cols = [
         "t_s", "x_m", "y_m", "z_m", "x_d_m", "y_d_m", "z_d_m",
@@ -192,6 +214,7 @@ def replay_controller_log(
         solve_time_s=times,
         solver=qp.solver,
         r_weight=float(qp.r_weight[2]),
+        from_log=from_log,
     )
 
 
