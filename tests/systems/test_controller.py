@@ -290,3 +290,12 @@ def test_surface_velocity_gradient_mode(sloped):
     assert out(diagram, context, "force_reference")[2] == pytest.approx(
         f_ref_z, rel=1e-12
     )
+
+
+def test_built_diagram_ignores_later_edits_of_its_params(phantom):
+    params, diagram, context = make(phantom, "vs-vf")
+    params.qp.stiffness_min_N_per_m[2] = 900.0  # After building: no effect.
+    params.reference.controller = "cs"
+    tick(diagram, context)
+    k = out(diagram, context, "stiffness")
+    assert k[2] < 900.0 and not np.allclose(k, 400.0)

@@ -9,6 +9,7 @@ state, advanced by a periodic discrete update at the controller rate.
 
 from __future__ import annotations
 
+import copy
 import math
 
 import numpy as np
@@ -55,7 +56,9 @@ class ForceReferenceSystem(LeafSystem):
 
     def __init__(self, params: ControllerParams, *, phantom: Phantom):
         super().__init__()
-        params.validate()
+        # A private copy: later edits of the caller's (mutable) params cannot
+        # change a built system.
+        params = copy.deepcopy(params).validate()
         self._params = params
         self._phantom = phantom
         self._sample = scalar_sampler(phantom)

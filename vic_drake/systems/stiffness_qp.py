@@ -10,6 +10,7 @@ Output ports only read that state; no solve happens in an output.
 
 from __future__ import annotations
 
+import copy
 import math
 
 import numpy as np
@@ -62,7 +63,9 @@ class StiffnessQpSystem(LeafSystem):
 
     def __init__(self, params: ControllerParams):
         super().__init__()
-        params.validate()
+        # A private copy: later edits of the caller's (mutable) params cannot
+        # change a built system.
+        params = copy.deepcopy(params).validate()
         self._params = params
         qp = params.qp
         self._k_min = tuple(float(v) for v in qp.stiffness_min_N_per_m)
@@ -165,9 +168,6 @@ class StiffnessQpSystem(LeafSystem):
         status.SetFromVector(
             [qp_ok, count, 1.0 if fault else 0.0, in_contact, solve_time, pen]
         )
-
-    def get_input_port_by_name(self, name: str):
-        return self._in[name]
 
     def get_stiffness_output_port(self):
         return self._stiffness_port

@@ -12,6 +12,8 @@ exactly the sequence of the real controller, with no lag.
 
 from __future__ import annotations
 
+import copy
+
 import numpy as np
 from pydrake.systems.framework import BasicVector, LeafSystem
 
@@ -50,7 +52,9 @@ class EnergyTankSystem(LeafSystem):
 
     def __init__(self, params: ControllerParams):
         super().__init__()
-        params.validate()
+        # A private copy: later edits of the caller's (mutable) params cannot
+        # change a built system.
+        params = copy.deepcopy(params).validate()
         self._tank = params.tank
         self._k_min = tuple(params.qp.stiffness_min_N_per_m)
         self._commit_port = self.DeclareVectorInputPort("commit", COMMIT_SIZE)
