@@ -245,6 +245,16 @@ def test_lag_profile_is_minimal_at_the_true_lag():
         lag_profile(data, -0.1)
 
 
+def test_lag_search_ignores_the_approach_transient():
+    data = synthetic_palpation(lag_s=0.04, noise_N=0.01, duration_s=8.0)
+    force = data.force_N.copy()
+    early = data.t_s < 0.9
+    force[early] = 1.0 + 3.0 * force[early]  # An unmodelled approach phase.
+    corrupt = PalpationData(data.t_s, data.z_m, force, data.surface_z_m)
+    assert estimate_lag(corrupt) == pytest.approx(0.04, abs=0.002)
+    assert estimate_lag(corrupt, settle_s=0.0) != pytest.approx(0.04, abs=0.002)
+
+
 def test_sweep_finds_the_generating_beta():
     data = synthetic_palpation(kappa=2000.0, lam=15000.0, beta=1.2, noise_N=0.02)
     sweep = sweep_beta(data)
@@ -387,3 +397,19 @@ def test_samples_next_to_a_timestamp_gap_are_not_fitted():
     assert fit.n_samples < gappy.n - 45
     assert fit.kappa == pytest.approx(4000.0, rel=1e-3)
     assert fit.lam == pytest.approx(20000.0, rel=1e-2)
+
+
+@pytest.mark.realdata
+def test_real_logs_agree_on_the_soft_material(real_comparisons):
+    """The three logs palpate the same soft material, so once the lag is
+    removed their HC parameters should agree (an unremoved lag shows up as a
+    wrong lambda: at lag 0 the 1 Hz log gives lambda ~ 1.6e3, 13x too low)."""
+    fits = [c.hunt_crossley[1.35] for c in real_comparisons.values()]
+    lams = np.array([f.lam for f in fits])
+    assert np.all(np.abs(lams / lams.mean() - 1.0) < 0.25), lams
+    # 1 and 2 Hz only: the 2.5 Hz log's logged surface sits ~1.5 mm above the
+    # tissue (no force over the first ~1.5 mm of travel), which lowers kappa.
+    kappas = np.array([f.kappa for f in fits[:2]])
+    assert abs(kappas[0] / kappas[1] - 1.0) < 0.1, kappas
+    lags = np.array([c.lag_s for c in real_comparisons.values()])
+    assert np.all((lags > 0.02) & (lags < 0.07)), lags
