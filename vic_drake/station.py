@@ -184,6 +184,9 @@ class StationParams:
     hunt_crossley_dissipation_s_per_m: float = 5.0  # Drake contact dissipation, s/m.
     friction_coefficient: float = 0.5  # Coulomb friction of the safety contact.
     robot_contact: bool = True  # Robot links and sensor collide with the phantom.
+    # Grid of the force element's per-step lookup of non-grid phantoms, m
+    # (a GridPhantom is looked up on its own grid).
+    tissue_lookup_resolution_m: float = 0.0005
 
     def __post_init__(self):
         positive = (
@@ -192,7 +195,7 @@ class StationParams:
             "indenter_mass_kg", "indenter_length_m", "indenter_tip_radius_m",
             "phantom_mass_kg", "phantom_kp_N_per_m", "phantom_mesh_resolution_m",
             "phantom_thickness_m", "hydroelastic_modulus_Pa",
-            "hydroelastic_resolution_hint_m",
+            "hydroelastic_resolution_hint_m", "tissue_lookup_resolution_m",
         )
         for name in positive:
             value = getattr(self, name)
@@ -753,6 +756,7 @@ def MakeStation(
         TissueForceElement(
             phantom, indenter_body_index=arm.indenter_body.index(), p_BT=p_IP,
             phantom_body_index=phantom_body.index(),
+            lookup_resolution_m=params.tissue_lookup_resolution_m,
         ),
     )
     builder.Connect(plant.get_body_poses_output_port(), tissue.get_body_poses_input_port())

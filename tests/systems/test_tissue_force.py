@@ -6,7 +6,7 @@ from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.math import SpatialVelocity
 from pydrake.multibody.tree import BodyIndex
 
-from vic_drake.systems.tissue_force import TissueForceElement, tip_contact
+from vic_drake.systems.tissue_force import GridLookup, TissueForceElement, tip_contact
 from vic_drake.tissue import GridPhantom, hunt_crossley_force
 
 
@@ -78,3 +78,41 @@ def test_system_applies_force_at_tip_and_reaction_on_phantom():
     np.testing.assert_allclose(on_tip.F_Bq_W.translational(), [0, 0, expected])
     np.testing.assert_allclose(on_phantom.F_Bq_W.translational(), [0, 0, -expected])
     np.testing.assert_allclose(on_phantom.p_BoBq_B, [0.01, 0.02, 0.09])
+
+
+def test_grid_lookup_equals_the_grid_phantom():
+    rng = np.random.default_rng(0)
+    xs = np.linspace(-0.1, 0.05, 31)
+    ys = np.linspace(-0.4, -0.3, 21)
+    X, Y = np.meshgrid(xs, ys, indexing="ij")
+    for lookup in ("bilinear", "nearest"):
+        ph = GridPhantom(
+            x_m=xs, y_m=ys, z_m=0.1 + 0.02 * np.sin(40 * X) * np.cos(30 * Y),
+            kappa=3000 + 500 * np.cos(50 * X), lam=2e4 + 1e3 * np.sin(20 * Y),
+            lookup=lookup,
+        )
+        fast = GridLookup(ph)
+        # Inside, on nodes, and outside the grid (clamped, zero gradient across).
+        pts = np.concatenate([
+            rng.uniform([-0.12, -0.42], [0.07, -0.28], (200, 2)),
+            np.stack(np.meshgrid(xs[::7], ys[::5]), -1).reshape(-1, 2),
+        ])
+        for x, y in pts:
+            a, b = ph.sample(x, y), fast.sample(x, y)
+            for name in ("surface_z_m", "dz_dx", "dz_dy", "kappa", "lam"):
+                assert getattr(b, name) == pytest.approx(float(getattr(a, name)), rel=1e-12,
+                                                         abs=1e-12), (lookup, name, x, y)
+
+
+def test_grid_lookup_of_the_synthetic_chest_is_close():
+    from vic_drake.tissue import SyntheticChestPhantom
+
+    ph = SyntheticChestPhantom()
+    fast = GridLookup(ph, resolution_m=0.0005)
+    rng = np.random.default_rng(1)
+    for x, y in rng.uniform([-0.2, -0.5], [0.08, -0.2], (100, 2)):
+        a, b = ph.sample(x, y), fast.sample(x, y)
+        assert b.surface_z_m == pytest.approx(float(a.surface_z_m), abs=2e-6)
+        assert b.kappa == pytest.approx(float(a.kappa), rel=5e-3)
+        assert b.lam == pytest.approx(float(a.lam), rel=1e-2)
+        assert b.dz_dx == pytest.approx(float(a.dz_dx), abs=1e-3)

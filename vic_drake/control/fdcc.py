@@ -220,6 +220,7 @@ def fdcc_step(
     stiffness,
     measured_force,
     target_force,
+    R_WP_target: RotationMatrix | None = None,
 ) -> FdccStep:
     """One FDCC controller tick (module docstring). Pure apart from ``model``'s scratch.
 
@@ -233,6 +234,8 @@ def fdcc_step(
         p_WP_target: target probe tip position in W, m (3,).
         stiffness: diagonal translational stiffness, N/m (3,), >= 0.
         measured_force, target_force: in W, sensor convention, N (3,).
+        R_WP_target: the orientation target; default ``params.R_WP_target``
+            (pass it to save rebuilding it every tick).
     """
     inputs = (q_measured, qdot, last_error, p_WP_target, stiffness, measured_force, target_force)
     arrays = [np.asarray(a, float) for a in inputs]
@@ -244,7 +247,7 @@ def fdcc_step(
     dt = params.internal_period_s
     p_gains = np.asarray(params.p_gains, float)
     d_gains = np.asarray(params.d_gains, float)
-    R_d = params.R_WP_target
+    R_d = params.R_WP_target if R_WP_target is None else R_WP_target
     K_rot = np.asarray(params.rotational_stiffness_Nm_per_rad, float)
     for _ in range(params.iterations):
         X_WP, H, J = model.dynamics(q)

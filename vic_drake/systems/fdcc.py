@@ -53,6 +53,7 @@ class FdccController(LeafSystem):
         if not isinstance(self._params, FdccParams):
             raise VicDrakeError(f"params must be FdccParams, got {type(params).__name__}")
         self._model = FdccModel(self._params, station_params)
+        self._R_WP_target = self._params.R_WP_target
         q0 = np.zeros(6) if initial_q is None else np.asarray(initial_q, float)
         if q0.shape != (6,) or not np.all(np.isfinite(q0)):
             raise VicDrakeError(f"initial_q must be 6 finite joint angles (rad), got {initial_q!r}")
@@ -116,6 +117,7 @@ class FdccController(LeafSystem):
             stiffness=self._stiffness_port.Eval(context),
             measured_force=self._measured_port.Eval(context),
             target_force=self._target_force_port.Eval(context),
+            R_WP_target=self._R_WP_target,
         )
         status = context.get_discrete_state(self._status).get_value()
         discrete_state.set_value(self._q_cmd, step.q_command)
