@@ -1,5 +1,21 @@
 """Online control math: energy tank, stiffness QP, force references, replay.
 
-Pure functions and dataclasses (no Drake systems here; see
-``vic_drake.systems`` for the LeafSystems that wrap them).
+Pure functions and dataclasses; the Drake LeafSystems that wrap them live in
+``vic_drake.systems`` (``references``, ``stiffness_qp``, ``tank``,
+``controller``).
+
+- :mod:`vic_drake.control.params`: ``ControllerParams`` (``period_s``,
+  ``tank: TankParams``, ``qp: StiffnessQpParams``,
+  ``reference: ReferenceParams``), defaults of the real controller.
+- :mod:`vic_drake.control.tank`: ``tank_step`` (T, dT/dt, sigma, enabled),
+  ``tank_qp_rows``.
+- :mod:`vic_drake.control.stiffness_qp`: ``make_stiffness_qp_problem``,
+  ``solve_stiffness_qp_exact`` (closed-form oracle and fast path),
+  ``StiffnessQp`` (MathematicalProgram built once; OSQP or Clarabel).
+- :mod:`vic_drake.control.references`: contact, penetration rate,
+  surface-velocity filter, ``force_references`` of CS, CF, VS-CF, VS-VF,
+  ``scalar_sampler`` (fast map lookup).
+- :mod:`vic_drake.control.replay`: ``replay_controller_log`` /
+  ``replay_bag`` (the real controller's 31-column logs through the same QP
+  and tank; ``vic-drake replay-qp``).
 """
