@@ -116,6 +116,13 @@ UR3E_JOINTS = (
 
 #: A configuration with the probe pointing down over the phantom (IK seed).
 DEFAULT_Q_SEED = (-2.1, -1.4, 1.7, -1.87, -1.57, -2.1)
+#: Further seeds tried when no q_seed is given and DEFAULT_Q_SEED fails
+#: (arm stretched out, arm pulled in, elbow-up home).
+FALLBACK_Q_SEEDS = (
+    (-2.1, -0.9, 0.9, -1.57, -1.57, -2.1),
+    (-2.1, -1.9, 2.4, -2.07, -1.57, -2.1),
+    (-1.57, -1.57, 1.57, -1.57, -1.57, 0.0),
+)
 
 
 def probe_down_rotation() -> RotationMatrix:
@@ -405,7 +412,8 @@ def solve_tip_ik(
 
     Args:
         p_WP: tip position in W (the rig's base_link), m (3,).
-        q_seed: initial guess and cost centre, rad (6,); default DEFAULT_Q_SEED.
+        q_seed: initial guess and cost centre, rad (6,); default
+            DEFAULT_Q_SEED, then FALLBACK_Q_SEEDS if that fails.
         params: station geometry (tool length); default StationParams().
         R_WP: tip orientation; default pointing straight down.
         position_tolerance_m, angle_tolerance_rad: constraint tolerances.
@@ -419,8 +427,9 @@ def solve_tip_ik(
     p_WP = np.asarray(p_WP, float)
     if p_WP.shape != (3,) or not np.all(np.isfinite(p_WP)):
         raise VicDrakeError(f"p_WP must be 3 finite numbers (m), got {p_WP!r}")
-    q_seed = np.asarray(DEFAULT_Q_SEED if q_seed is None else q_seed, float)
-    if q_seed.shape != (6,) or not np.all(np.isfinite(q_seed)):
+    seeds = [DEFAULT_Q_SEED, *FALLBACK_Q_SEEDS] if q_seed is None else [q_seed]
+    seeds = [np.asarray(seed, float) for seed in seeds]
+    if seeds[0].shape != (6,) or not np.all(np.isfinite(seeds[0])):
         raise VicDrakeError(f"q_seed must be 6 finite joint angles (rad), got {q_seed!r}")
     plant, handles = MakeUr3ePlant(params)
     R_WP = R_WP or probe_down_rotation()
@@ -434,17 +443,18 @@ def solve_tip_ik(
     )
     prog = ik.get_mutable_prog()
     q = ik.q()
-    prog.AddQuadraticErrorCost(np.eye(6), q_seed, q)
-    prog.SetInitialGuess(q, q_seed)
-    result = Solve(prog)
-    q_sol = result.GetSolution(q)
-    if not result.is_success():
-        raise VicDrakeError(
-            f"no joint configuration puts the probe tip at {p_WP.tolist()} m pointing down "
-            f"(solver {result.get_solver_id().name()}); the UR3e reaches about 0.5 m "
-            "from its shoulder"
-        )
-    return q_sol
+    cost = prog.AddQuadraticErrorCost(np.eye(6), seeds[0], q)
+    for seed in seeds:
+        cost.evaluator().UpdateCoefficients(2 * np.eye(6), -2 * seed, seed @ seed)
+        prog.SetInitialGuess(q, seed)
+        result = Solve(prog)
+        if result.is_success():
+            return result.GetSolution(q)
+    raise VicDrakeError(
+        f"no joint configuration puts the probe tip at {p_WP.tolist()} m pointing down "
+        f"(solver {result.get_solver_id().name()}, {len(seeds)} seed(s)); the UR3e "
+        "reaches about 0.5 m from its shoulder"
+    )
 
 
 def initial_q_for_tip(p_WP, params: StationParams | None = None) -> np.ndarray:
@@ -842,6 +852,7 @@ def set_station_state(station: Diagram, station_context, q, *, phantom_lift_m: f
 
 __all__ = [
     "DEFAULT_Q_SEED",
+    "FALLBACK_Q_SEEDS",
     "UR3E_JOINTS",
     "AddTool",
     "AddUr3e",
