@@ -186,6 +186,7 @@ def test_fit_palpation_human_summary(capsys, data_dir):
         and "Hunt-Crossley b=1.35" in out
         and "sensor lag 50.0 ms" in out
     )
+    assert "residual vs palpation time" in out and "exp(-T /" in out
 
 
 @pytest.mark.realdata

@@ -178,6 +178,18 @@ def _fit_palpation(args: argparse.Namespace) -> int:
             f"kappa = {f.kappa:.1f}, lambda = {f.lam:.1f}"
         )
     lines.append(f"best beta in [1.0, 2.0]: {result.best_beta:.3f}")
+    if not args.json:
+        from vic_drake.estimation.palpation import residual_vs_palpation_time, shift
+
+        curve = residual_vs_palpation_time(
+            shift(data, result.lag_s), indenter_mass_kg=mass
+        )
+        f = curve.exp_fit
+        if f is not None:
+            lines.append(
+                "residual vs palpation time (Fig. 3, beta = 1.35, fit on the first T s, "
+                f"scored on the whole log): {f.a:.3g} exp(-T / {f.tau_s:.3g} s) + {f.c:.3g}"
+            )
     lines.append(_RELATIVE_HELP)
     emit(out, args.json, "\n".join(lines))
     return 0
