@@ -11,7 +11,8 @@ with F_tissue clipped at zero (tissue cannot pull the probe). The load
 test's force is aligned with the palpation's lag (same sensor chain). The
 error is the RMS of F_measured - F_pred over the samples where the probe is
 in the tissue (eps > 0) or the sensor reads more than the contact threshold,
-so a model is charged both for missing force and for inventing it.
+so a model is charged both for missing force and for inventing it (force
+spikes and samples next to timestamp gaps are left out, as in the fits).
 """
 
 from __future__ import annotations
@@ -35,6 +36,7 @@ from vic_drake.estimation.palpation import (
     fit_kelvin_voigt,
     kinematics,
     shift,
+    spike_mask,
 )
 from vic_drake.estimation.signals import DEFAULT_DERIVATIVE_WINDOW_S
 
@@ -132,6 +134,9 @@ def load_test(
     aligned = shift(load, lag_s)
     kin = kinematics(aligned, window_s=derivative_window_s)
     mask = (kin.eps_m > 0.0) | (aligned.force_N > DEFAULT_MIN_FORCE_N)
+    mask &= spike_mask(aligned.force_N)
+    if kin.valid is not None:
+        mask &= kin.valid
     if mask.sum() < MIN_LOAD_SAMPLES:
         raise VicDrakeError(
             f"the load test has only {int(mask.sum())} samples in contact "
