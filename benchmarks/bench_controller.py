@@ -127,7 +127,7 @@ def bench_functions(
                 problem = make_stiffness_qp_problem(
                     e, e_dot, d, refs.force_ref, refs.force_min, energy, dt, qp, tank
                 )
-                k = qp_solver.solve(problem).stiffness
+                k = qp_solver.solve(problem, guess=k_prev).stiffness
             else:
                 k = k_min
             t2 = time.perf_counter()

@@ -161,6 +161,11 @@ def test_mathematical_program_matches_exact_oracle(osqp, p):
     assert viol["bounds_N_per_m"] <= 1e-6 and viol["force_N"] <= 1e-6
     assert viol["tank_energy_W"] <= 1e-6 and viol["tank_power_W"] <= 1e-6
     assert np.allclose(mp.stiffness, exact.stiffness, atol=1e-6, rtol=0)
+    # Warm-started from a far point, OSQP lands on the same optimum.
+    warm = osqp.solve(p, guess=p.stiffness_max)
+    assert warm.success and np.allclose(
+        warm.stiffness, exact.stiffness, atol=1e-6, rtol=0
+    )
     # The oracle is optimal: no feasible point of the solver is cheaper.
     assert (
         stiffness_qp_cost(p, exact.stiffness)

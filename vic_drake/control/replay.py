@@ -196,7 +196,7 @@ def replay_controller_log(
                 e, e_dot, damping, (0.0, 0.0, f_ref_z), (*f_min_xy, f_min_z),
                 energy, dt, qp, tank,
             )  # fmt: skip
-            sol = solver_obj.solve(problem)
+            sol = solver_obj.solve(problem, guess=k_prev)  # The logged previous K.
             k = sol.stiffness
             success[j] = sol.success
             times[j] = sol.solve_time_s

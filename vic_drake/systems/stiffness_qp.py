@@ -154,7 +154,7 @@ class StiffnessQpSystem(LeafSystem):
                     e, e_dot, d_used, f_ref, f_min, energy, self._dt,
                     self._params.qp, self._params.tank,
                 )  # fmt: skip
-                sol = self._solver.solve(problem)
+                sol = self._solver.solve(problem, guess=k_prev)  # Warm start (OSQP).
                 k = sol.stiffness
                 solve_time = sol.solve_time_s
                 if not sol.success:
