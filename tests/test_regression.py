@@ -158,3 +158,50 @@ def test_compare_to_golden_names_the_moved_metric(tmp_path, monkeypatch):
         compare_to_golden("c", {"force_N": 7.3, "ok": True}, {})
     with pytest.raises(AssertionError, match="ok: True -> False"):
         compare_to_golden("c", {"force_N": 7.0, "ok": False}, {})
+
+
+SCAN_TOLERANCES = {
+    "force_mean_N": TOL_FORCE,
+    "force_rmse_N": TOL_FORCE,
+    "force_range_N": TOL_FORCE,
+    "peak_force_N": TOL_FORCE,
+    "final_force_N": TOL_FORCE,
+    "lifted_off": (0, 0, "a boolean outcome"),
+    "penetration_off_ribs_median_m": TOL_PEN,
+    "penetration_error_off_ribs_median_m": TOL_PEN,
+    "force_on_ribs_p99_N": TOL_FORCE,
+    "n_contact_losses": (0, 0, "count of contact losses >= 0.1 s"),
+    "fraction_at_k_min_during_loss": TOL_FRACTION,
+    "tank_min_J": TOL_TANK,
+    "tank_power_min_W": TOL_POWER,
+    "stiffness_z_max_N_per_m": TOL_STIFF,
+}
+
+
+def _scan_case(controller: str, *, disturbed: bool, duration_s: float) -> dict:
+    from vic_drake.claims import scan_metrics
+    from vic_drake.experiments import run_scan
+    from vic_drake.reproduce import scan_limits, scan_scenario
+
+    scenario = scan_scenario(controller, disturbed=disturbed, phantom_kind="synthetic",
+                             quick=True)
+    result = run_scan(scenario, duration_s=duration_s)
+    m = scan_metrics(result.df, limits=scan_limits(scenario))
+    return {k: m[k] for k in SCAN_TOLERANCES if k in m}
+
+
+def test_golden_scan_vs_vf_nominal():
+    """6 s of the default VS-VF scan on the synthetic chest (approach + 3.5 s of
+    scanning): force tracking, penetration, stiffness, tank."""
+    metrics = _scan_case("vs-vf", disturbed=False, duration_s=6.0)
+    compare_to_golden("scan_vs_vf_nominal_6s", metrics,
+                      {k: SCAN_TOLERANCES[k] for k in metrics})
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("controller", ["vs-vf", "cs", "cf"])
+def test_golden_scan_disturbance(controller):
+    """The quick disturbance scan (one lift) of each disturbed controller."""
+    metrics = _scan_case(controller, disturbed=True, duration_s=None)
+    compare_to_golden(f"scan_{controller.replace('-', '_')}_disturbance_quick", metrics,
+                      {k: SCAN_TOLERANCES[k] for k in metrics})

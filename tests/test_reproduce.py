@@ -59,3 +59,43 @@ def test_real_scan_frame_layouts(data_dir):
                                     / REAL_SCAN_LOGS[("nominal", "vs-vf")]))
     # Tank power = change per tick / tick period; the valve holds it near -0.1 W.
     assert vsvf["tank_power_W"].min() == pytest.approx(-0.1, abs=0.01)
+
+
+def test_scan_scenarios_cover_the_paper_runs():
+    from vic_drake.reproduce import CONTROLLERS, scan_limits, scan_scenario
+
+    for quick in (True, False):
+        for c in CONTROLLERS:
+            s = scan_scenario(c, disturbed=False, phantom_kind="synthetic", quick=quick)
+            assert s.controller.reference.controller == c
+            assert s.disturbance.is_nominal
+        d = scan_scenario("vs-vf", disturbed=True, phantom_kind="synthetic", quick=quick)
+        lifts = d.disturbance.lifts
+        assert len(lifts) == (2 if quick else 4)
+        # Every event ends (phantom back at rest) before the target lifts off.
+        traj = d.trajectory
+        scan_end = traj.end_time_s - traj.liftoff_s
+        for lift in lifts:
+            assert lift.start_s + lift.rise_s + lift.hold_s + lift.fall_s < scan_end
+        # Dropped below rest: contact loss must be possible.
+        assert min(lift.height_m for lift in lifts) < 0
+    lim = scan_limits(scan_scenario("vs-vf", disturbed=False, phantom_kind="synthetic",
+                                    quick=True))
+    assert lim.k_min_z_N_per_m == 100.0 and lim.tank_min_J == 0.4
+    assert lim.power_max_W == pytest.approx(0.1) and lim.eps_d_m == 0.008
+
+
+@pytest.mark.slow
+def test_reproduce_quick_end_to_end(tmp_path):
+    """The whole quick pipeline: every stage runs, every output exists."""
+    assert main(["reproduce", "--quick", "--out", str(tmp_path), "--quiet"]) == 0
+    run = json.loads((tmp_path / "run.json").read_text())
+    failed = [s for s in run["stages"] if not s["ok"]]
+    assert not failed, failed
+    claims = json.loads((tmp_path / "claims.json").read_text())
+    assert all(c["sim"] is not None for c in claims.values())
+    assert (tmp_path / "report.html").stat().st_size > 100_000
+    assert (tmp_path / "replay.html").is_file()
+    logs = sorted(p.name for p in (tmp_path / "logs").iterdir())
+    assert sum(n.endswith(".parquet") for n in logs) == 7
+    assert sum(n.endswith(".yaml") for n in logs) == 7

@@ -482,64 +482,70 @@ def _plot_surface(pts):
 # --- Scans --------------------------------------------------------------------
 
 
-def disturbance_lifts(t_scan_start_s: float):
-    """The phantom lifted by hand and dropped (contact loss and re-contact).
+#: Quick mode: the target starts 11 cm high (2-3 mm above the surface at the
+#: start) and scans QUICK_SCAN_M along -x.
+QUICK_APPROACH_Z_M = 0.11
+QUICK_SCAN_M = 0.05
+#: The disturbance events start this long after the target reaches its
+#: scanning height (quick: the first only; full: both).
+DISTURBANCE_DELAYS_S = (0.5, 8.0)
 
-    The phantom rises by 15 mm over 0.5 s, 2 s into the scan, is held 1 s and
-    drops back quickly (0.15 s), then dips 10 mm below its rest for 1 s: the
-    drop outruns the compliant probe, which loses contact and touches again.
+
+def disturbance_lifts(t_scan_start_s: float, *, events: int = 1):
+    """The phantom lifted by hand, let go and caught again (Fig. 7).
+
+    Each event: the phantom rises 15 mm over 0.5 s and is held 1 s (the probe
+    is pushed away from its target), then drops over 0.2 s to 10 mm BELOW
+    its rest, faster than the compliant probe can follow (contact is lost),
+    stays there 0.8 s and comes back up over 0.5 s (re-contact). The
+    synthetic lifts of ``diagrams/`` rise and fall over about 1 s and the probe
+    follows them without losing contact, so they cannot test C7's "K falls to
+    K_min while contact is lost".
     """
     from vic_drake.scenario import PhantomLift
 
-    t = t_scan_start_s + 2.0
-    return [
-        PhantomLift(start_s=t, height_m=0.015, rise_s=0.5, hold_s=1.0, fall_s=0.15),
-        PhantomLift(start_s=t + 1.65, height_m=-0.010, rise_s=0.15, hold_s=1.0, fall_s=0.5),
-    ]
+    lifts = []
+    for delay in DISTURBANCE_DELAYS_S[:events]:
+        t = t_scan_start_s + delay
+        lifts.append(PhantomLift(start_s=t, height_m=0.015, rise_s=0.5, hold_s=1.0,
+                                 fall_s=0.2))
+        lifts.append(PhantomLift(start_s=t + 1.7, height_m=-0.010, rise_s=0.2,
+                                 hold_s=0.8, fall_s=0.5))
+    return lifts
 
 
 def scan_scenario(controller: str, *, disturbed: bool, phantom_kind: str, quick: bool):
-    """The scenario of one scan of the paper (nominal or disturbed).
+    """The scenario of one of the paper's scans (nominal or disturbed).
 
-    Defaults of :class:`vic_drake.scenario.Scenario` (the real rig's scan:
-    target 0.085 m, 1 cm/s along -x, lift-off at the end) with the
-    controller's settings of the real experiments: R = 0.1 (VS-CF), 1e-5
-    (VS-VF); CS at 400 N/m with FDCC's default z gains; CF at 7 N. Quick mode
-    scans 8 cm instead of 20 cm.
+    :func:`vic_drake.experiments.synthetic_scenario` (the scenarios of
+    ``diagrams/``: the real rig's scan and controller settings) on the
+    requested phantom, with :func:`disturbance_lifts` as the disturbance.
+    Quick mode shortens the approach and the scan (QUICK_* constants) and
+    has one disturbance event instead of two.
     """
     from dataclasses import replace
 
-    from vic_drake.experiments import CS_FDCC_Z_GAINS, DEFAULT_R
-    from vic_drake.scenario import DisturbanceConfig, PhantomConfig, Scenario
+    from vic_drake.experiments import synthetic_scenario
+    from vic_drake.scenario import DisturbanceConfig
 
-    base = Scenario()
-    ctrl = base.controller
-    ref = replace(ctrl.reference, controller=controller)
-    qp = ctrl.qp
-    if controller in DEFAULT_R:
-        r = DEFAULT_R[controller]
-        qp = replace(qp, r_weight=[r, r, r])
-    fdcc = base.fdcc
-    if controller == "cs":
-        from vic_drake.control.fdcc import with_force_gains
-
-        fdcc = with_force_gains(fdcc, axis=2, p=CS_FDCC_Z_GAINS[0], d=CS_FDCC_Z_GAINS[1])
+    base = synthetic_scenario(controller, disturbed=False)
     traj = base.trajectory
     if quick:
-        traj = replace(traj, end_x_m=traj.start_x_m - 0.08)
-    t_scan = traj.start_delay_s + (traj.approach_z_m - traj.target_z_m) / \
-        traj.approach_speed_m_per_s + traj.dwell_s
-    disturbance = DisturbanceConfig(lifts=disturbance_lifts(t_scan)) if disturbed \
-        else DisturbanceConfig()
+        traj = replace(traj, approach_z_m=QUICK_APPROACH_Z_M,
+                       end_x_m=traj.start_x_m - QUICK_SCAN_M)
+    disturbance = DisturbanceConfig()
+    if disturbed:
+        t_scan = (traj.start_delay_s + (traj.approach_z_m - traj.target_z_m)
+                  / traj.approach_speed_m_per_s + traj.dwell_s)
+        disturbance = DisturbanceConfig(
+            lifts=disturbance_lifts(t_scan, events=1 if quick else 2))
     cond = "disturbance" if disturbed else "nominal"
     return replace(
         base,
-        name=f"{controller.replace('-', '_')}_{cond}_{phantom_kind}",
-        description=f"{controller.upper()} scan, {cond}, {phantom_kind} phantom "
+        name=f"{cond}_{controller.replace('-', '_')}_{phantom_kind}",
+        description=f"{controller.upper()} {cond} scan on the {phantom_kind} phantom "
         f"({'quick' if quick else 'full'} mode)",
-        phantom=PhantomConfig(kind=phantom_kind),
-        controller=replace(ctrl, reference=ref, qp=qp),
-        fdcc=fdcc,
+        phantom=replace(base.phantom, kind=phantom_kind),
         trajectory=traj,
         disturbance=disturbance,
     )
@@ -556,33 +562,62 @@ def scan_limits(scenario) -> claims_mod.ScanLimits:
     )
 
 
+def _run_scan_job(args):
+    """Worker: one scan (module-level so a spawned process can run it)."""
+    from vic_drake.experiments import run_scan
+
+    scenario, data_dir = args
+    return run_scan(scenario, data_dir=data_dir)
+
+
 def stage_scans(ctx: RunContext) -> dict:
     """The four controllers nominal, VS-VF/CS/CF disturbed; logs; Fig. 6-7.
 
-    The nominal VS-VF run is recorded in Meshcat (when it starts) for the
-    replay.
+    The scans run in worker processes (one per spare core) and, for the
+    nominal VS-VF scan, in this process.
     """
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
     from vic_drake.experiments import run_scan
     from vic_drake.scenario import save_scenario
-    from vic_drake.tissue import load_phantom
 
-    phantom = load_phantom(ctx.phantom_kind, data_dir=ctx.data_dir)
     runs = [("nominal", c) for c in CONTROLLERS] + \
         [("disturbance", c) for c in DISTURBANCE_CONTROLLERS]
+    scenarios = {
+        key: scan_scenario(key[1], disturbed=key[0] == "disturbance",
+                           phantom_kind=ctx.phantom_kind, quick=ctx.options.quick)
+        for key in runs
+    }
     logs = ctx.out_dir / "logs"
     logs.mkdir(parents=True, exist_ok=True)
+    local_key = ("nominal", "vs-vf")
+    workers = max(1, (os.cpu_count() or 1) - 1)
+    remote = [k for k in runs if k != local_key]
+    ctx.progress(f"  {len(runs)} scans: {len(remote)} in {workers} worker process(es), "
+                 f"{local_key[1]} {local_key[0]} in this one")
+    results = {}
+    with ProcessPoolExecutor(max_workers=workers,
+                             mp_context=multiprocessing.get_context("spawn")) as pool:
+        futures = {pool.submit(_run_scan_job, (scenarios[k], ctx.data_dir)): k
+                   for k in remote}
+        t0 = time.perf_counter()
+        results[local_key] = run_scan(scenarios[local_key], data_dir=ctx.data_dir)
+        _report_scan(ctx, scenarios[local_key], results[local_key], len(results), len(runs))
+        from concurrent.futures import as_completed
+
+        for fut in as_completed(futures):
+            k = futures[fut]
+            results[k] = fut.result()
+            _report_scan(ctx, scenarios[k], results[k], len(results), len(runs))
+        ctx.progress(f"  scans done in {time.perf_counter() - t0:.1f} s")
     frames: dict = {"nominal": {}, "disturbance": {}}
     metrics: dict = {"nominal": {}, "disturbance": {}}
     timing = []
     limits = None
-    for i, (cond, ctrl) in enumerate(runs):
-        scenario = scan_scenario(ctrl, disturbed=cond == "disturbance",
-                                 phantom_kind=ctx.phantom_kind, quick=ctx.options.quick)
-        meshcat = _start_meshcat(ctx) if (cond, ctrl) == ("nominal", "vs-vf") else None
-        ctx.progress(f"  scan {i + 1}/{len(runs)}: {scenario.description}")
-        result = run_scan(scenario, phantom=phantom, meshcat=meshcat, data_dir=ctx.data_dir)
-        if meshcat is not None:
-            ctx.results["_meshcat"] = meshcat
+    for key in runs:
+        cond, ctrl = key
+        scenario, result = scenarios[key], results[key]
         df = result.df
         df.to_parquet(logs / f"{scenario.name}.parquet", index=False)
         save_scenario(scenario, logs / f"{scenario.name}.yaml")
@@ -590,18 +625,20 @@ def stage_scans(ctx: RunContext) -> dict:
         limits = limits or lim
         frames[cond][ctrl] = df
         metrics[cond][ctrl] = claims_mod.scan_metrics(df, limits=lim)
-        timing.append({"run": scenario.name, "sim_s": result.sim_s, "wall_s": result.wall_s,
-                       "rtf": result.rtf})
-        ctx.progress(f"  scan {i + 1}/{len(runs)} done: {result.sim_s:.1f} s simulated in "
-                     f"{result.wall_s:.1f} s (RTF {result.rtf:.2f})")
+        timing.append([scenario.name, result.sim_s, result.wall_s, result.rtf])
     _scan_figures(ctx, frames)
     from vic_drake.report import ReportTable
 
-    ctx.tables.append(ReportTable("Simulated scans: timing", ["run", "simulated [s]",
-                                                              "wall [s]", "RTF"],
-                                  [[t["run"], t["sim_s"], t["wall_s"], t["rtf"]]
-                                   for t in timing]))
-    return {"frames": frames, "metrics": metrics, "limits": limits, "timing": timing}
+    ctx.tables.append(ReportTable(
+        "Simulated scans: timing", ["run", "simulated [s]", "wall [s]", "real-time factor"],
+        timing, f"{workers} worker process(es) plus the main process."))
+    return {"frames": frames, "metrics": metrics, "limits": limits, "timing": timing,
+            "scenarios": scenarios}
+
+
+def _report_scan(ctx, scenario, result, done: int, total: int) -> None:
+    ctx.progress(f"  scan {done}/{total} {scenario.name}: {result.sim_s:.1f} s simulated "
+                 f"in {result.wall_s:.1f} s (real-time factor {result.rtf:.2f})")
 
 
 def _scan_figures(ctx: RunContext, frames: dict) -> None:
@@ -628,31 +665,67 @@ def _scan_figures(ctx: RunContext, frames: dict) -> None:
                        plot_fig7(dist, real.get("disturbance")), "fig7_disturbance.png")
 
 
-def _start_meshcat(ctx: RunContext):
-    """A Meshcat recording (None if Meshcat cannot start here)."""
-    if ctx.options.stages is not None and "replay" not in ctx.options.stages:
-        return None
-    try:
-        from pydrake.geometry import Meshcat
+#: Frames per second of the Meshcat replay.
+REPLAY_FPS = 25.0
 
-        meshcat = Meshcat()
-        meshcat.StartRecording(frames_per_second=32.0)
-        return meshcat
-    except Exception as exc:  # noqa: BLE001 - the replay is optional
-        ctx.progress(f"  Meshcat unavailable ({exc}); no replay")
-        return None
+
+def replay_scan(df: pd.DataFrame, scenario, *, phantom, fps: float = REPLAY_FPS) -> str:
+    """A standalone Meshcat HTML animation of a logged scan.
+
+    The station (arm, tool, phantom) is posed at every frame from the log: the
+    joint angles commanded by FDCC (``q_cmd_*_rad``; the arm's servo follows
+    them within a few ms) and the phantom's lift (``phantom_lift_m``), and
+    published into a Meshcat recording; no simulation runs.
+
+    Returns:
+        The HTML text (``Meshcat.StaticHtml()``).
+    """
+    from pydrake.geometry import Meshcat
+    from pydrake.systems.framework import DiagramBuilder
+
+    from vic_drake.station import MakeStation, set_station_state
+
+    q_cols = [f"q_cmd_{i}_rad" for i in range(6)]
+    missing = [c for c in [*q_cols, "t_s", "phantom_lift_m"] if c not in df.columns]
+    if missing:
+        raise VicDrakeError(f"replay_scan: the log lacks columns {missing}")
+    meshcat = Meshcat()
+    builder = DiagramBuilder()
+    station = builder.AddNamedSystem(
+        "station", MakeStation(scenario.station, phantom=phantom, meshcat=meshcat))
+    diagram = builder.Build()
+    context = diagram.CreateDefaultContext()
+    station_context = station.GetMyMutableContextFromRoot(context)
+    t = df["t_s"].to_numpy()
+    frames = np.arange(t[0], t[-1], 1.0 / fps)
+    idx = np.searchsorted(t, frames).clip(0, len(t) - 1)
+    q = df[q_cols].to_numpy()
+    lift = df["phantom_lift_m"].to_numpy()
+    meshcat.StartRecording(frames_per_second=fps, set_visualizations_while_recording=False)
+    for i, tf in zip(idx, frames):
+        context.SetTime(float(tf))
+        set_station_state(station, station_context, q[i], phantom_lift_m=float(lift[i]))
+        diagram.ForcedPublish(context)
+    meshcat.StopRecording()
+    meshcat.PublishRecording()
+    return meshcat.StaticHtml()
 
 
 def stage_replay(ctx: RunContext) -> dict:
-    """The Meshcat recording of the nominal VS-VF scan as a standalone HTML file."""
-    meshcat = ctx.results.pop("_meshcat", None)
-    if meshcat is None:
-        raise StageSkipped("no Meshcat recording (the scans stage did not record one)")
-    meshcat.StopRecording()
-    meshcat.PublishRecording()
+    """The nominal VS-VF scan as a standalone Meshcat animation (replay.html)."""
+    from vic_drake.tissue import load_phantom
+
+    scans = ctx.results.get("scans")
+    if not scans:
+        raise StageSkipped("no simulated scan to replay (the scans stage did not run)")
+    key = ("nominal", "vs-vf")
+    df = scans["frames"][key[0]][key[1]]
+    scenario = scans["scenarios"][key]
+    phantom = load_phantom(ctx.phantom_kind, data_dir=ctx.data_dir)
+    html = replay_scan(df, scenario, phantom=phantom)
     path = ctx.out_dir / "replay.html"
-    path.write_text(meshcat.StaticHtml(), encoding="utf-8")
-    return {"path": path, "bytes": path.stat().st_size}
+    path.write_text(html, encoding="utf-8")
+    return {"path": path, "bytes": path.stat().st_size, "scenario": scenario.name}
 
 
 # --- Claims and report --------------------------------------------------------
