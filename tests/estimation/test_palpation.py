@@ -414,3 +414,34 @@ def test_real_logs_agree_on_the_soft_material(real_comparisons):
     assert abs(kappas[0] / kappas[1] - 1.0) < 0.1, kappas
     lags = np.array([c.lag_s for c in real_comparisons.values()])
     assert np.all((lags > 0.02) & (lags < 0.07)), lags
+
+
+def test_fit_is_linear_in_force_and_ignores_the_time_origin():
+    data = synthetic_palpation(noise_N=0.02, duration_s=4.0)
+    base = fit_hunt_crossley(data, 1.35, indenter_mass_kg=0.0)
+    doubled = PalpationData(
+        data.t_s + 1e4, data.z_m, 2.0 * data.force_N, data.surface_z_m
+    )
+    fit = fit_hunt_crossley(doubled, 1.35, indenter_mass_kg=0.0)
+    assert fit.kappa == pytest.approx(2.0 * base.kappa, rel=1e-6)
+    assert fit.lam == pytest.approx(2.0 * base.lam, rel=1e-5)
+    assert fit.relative == pytest.approx(base.relative, rel=1e-5)
+
+
+def test_surface_array_matches_scalar_surface():
+    data = synthetic_palpation(noise_N=0.02, duration_s=4.0)
+    as_array = PalpationData(
+        data.t_s, data.z_m, data.force_N, np.full(data.n, data.surface_z_m)
+    )
+    a = fit_hunt_crossley(data, 1.35)
+    b = fit_hunt_crossley(as_array, 1.35)
+    assert b.kappa == pytest.approx(a.kappa, rel=1e-9)
+    assert b.lam == pytest.approx(a.lam, rel=1e-6)
+    # A rising surface (phantom lifted) changes eps_dot by s_dot.
+    lift = 0.001 * data.t_s
+    moving = PalpationData(
+        data.t_s, data.z_m + lift, data.force_N, data.surface_z_m + lift
+    )
+    c = fit_hunt_crossley(moving, 1.35)
+    assert c.kappa == pytest.approx(a.kappa, rel=1e-6)
+    assert c.lam == pytest.approx(a.lam, rel=1e-3)
