@@ -208,3 +208,13 @@ def test_load_test_json(capsys, data_dir, tmp_path):
     assert result["beta"] == 1.35
     assert result["hunt_crossley_rms_N"] < result["kelvin_voigt_rms_N"]
     assert plot.stat().st_size > 10_000
+
+
+@pytest.mark.realdata
+def test_bag_relative_to_the_data_folder(capsys, data_dir, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("VIC_DRAKE_DATA", str(data_dir))
+    argv = ["fit-palpation", "palpation/test_soft_25hz", "--lag", "0.05", "--json"]
+    status, out, _ = run(capsys, argv)
+    assert status == 0
+    assert json.loads(out)["lag_s"] == 0.05
