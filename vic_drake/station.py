@@ -191,6 +191,10 @@ class StationParams:
     hunt_crossley_dissipation_s_per_m: float = 5.0  # Drake contact dissipation, s/m.
     friction_coefficient: float = 0.5  # Coulomb friction of the safety contact.
     robot_contact: bool = True  # Robot links and sensor collide with the phantom.
+    # Optional sliding friction of the tissue on the tip (times the HC force);
+    # 0 = the paper's model. About 0.3 matches the real scans' |f_x| of 2 N.
+    tissue_friction_coefficient: float = 0.0
+    tissue_slip_speed_m_per_s: float = 0.005  # Regularisation speed of that friction, m/s.
     # Grid of the force element's per-step lookup of non-grid phantoms, m
     # (a GridPhantom is looked up on its own grid).
     tissue_lookup_resolution_m: float = 0.0005
@@ -203,13 +207,15 @@ class StationParams:
             "phantom_mass_kg", "phantom_kp_N_per_m", "phantom_mesh_resolution_m",
             "phantom_thickness_m", "hydroelastic_modulus_Pa",
             "hydroelastic_resolution_hint_m", "tissue_lookup_resolution_m",
+            "tissue_slip_speed_m_per_s",
         )
         for name in positive:
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and np.isfinite(value) and value > 0):
                 raise VicDrakeError(f"StationParams.{name} must be a number > 0, got {value!r}")
         nonneg = ("servo_integral_time_s", "sensor_torque_noise_std_Nm", "phantom_kd_Ns_per_m",
-                  "hunt_crossley_dissipation_s_per_m", "friction_coefficient")
+                  "hunt_crossley_dissipation_s_per_m", "friction_coefficient",
+                  "tissue_friction_coefficient")
         for name in nonneg:
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and np.isfinite(value) and value >= 0):
@@ -767,6 +773,8 @@ def MakeStation(
             phantom, indenter_body_index=arm.indenter_body.index(), p_BT=p_IP,
             phantom_body_index=phantom_body.index(),
             lookup_resolution_m=params.tissue_lookup_resolution_m,
+            friction_coefficient=params.tissue_friction_coefficient,
+            slip_speed_m_per_s=params.tissue_slip_speed_m_per_s,
         ),
     )
     builder.Connect(plant.get_body_poses_output_port(), tissue.get_body_poses_input_port())

@@ -116,3 +116,15 @@ def test_grid_lookup_of_the_synthetic_chest_is_close():
         assert b.kappa == pytest.approx(float(a.kappa), rel=5e-3)
         assert b.lam == pytest.approx(float(a.lam), rel=1e-2)
         assert b.dz_dx == pytest.approx(float(a.dz_dx), abs=1e-3)
+
+
+def test_optional_friction_opposes_sliding_and_scales_with_the_normal_force():
+    ph = _plane_phantom(gx=0.0, gy=0.0)
+    v = np.array([-0.01, 0.0, 0.0])  # sliding along -x at 1 cm/s
+    none = tip_contact(ph, [0, 0, 0.09], v)
+    assert none.friction_x_N == 0.0 and none.friction_y_N == 0.0
+    c = tip_contact(ph, [0, 0, 0.09], v, friction_coefficient=0.3, slip_speed_m_per_s=1e-4)
+    assert c.friction_x_N == pytest.approx(0.3 * c.force_N, rel=1e-3)
+    assert c.friction_y_N == 0.0
+    off = tip_contact(ph, [0, 0, 0.11], v, friction_coefficient=0.3)
+    assert off.friction_x_N == 0.0

@@ -21,8 +21,11 @@ Geometry and signs (all in the world frame W = the rig's ``base_link``):
   beta, clip_tension=True)`` (zero out of contact, never pulling), applied
   along +z of W at T on the indenter body; the equal and opposite force acts
   on the phantom body at the same point. The map's kappa and lambda were
-  fitted to vertical indentations, so the force is vertical; tangential
-  (friction) forces are not modelled.
+  fitted to vertical indentations, so the force is vertical. An optional
+  regularised sliding friction in the horizontal plane (coefficient mu times
+  the Hunt-Crossley force) is off by default: the paper does not model it,
+  though the real scans' sensor x force (about 2 N at 7 N pressing while
+  sliding at 1 cm/s) suggests mu of about 0.3.
 """
 
 from __future__ import annotations
@@ -53,6 +56,8 @@ class TipContact:
         surface_z_m: tissue surface height under the tip, in W.
         kappa: Hunt-Crossley elasticity at the tip, N/m^beta.
         lam: Hunt-Crossley viscosity at the tip, N s/m^(beta+1).
+        friction_x_N, friction_y_N: optional tangential friction on the tip
+            in W's x and y (zero unless a friction coefficient is set).
     """
 
     force_N: float
@@ -61,6 +66,8 @@ class TipContact:
     surface_z_m: float
     kappa: float
     lam: float
+    friction_x_N: float = 0.0
+    friction_y_N: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -140,6 +147,9 @@ def tip_contact(
     v_WT,
     p_WPh=(0.0, 0.0, 0.0),
     v_WPh=(0.0, 0.0, 0.0),
+    *,
+    friction_coefficient: float = 0.0,
+    slip_speed_m_per_s: float = 0.005,
 ) -> TipContact:
     """Hunt-Crossley contact of the probe tip T with a translated phantom Ph.
 
@@ -150,6 +160,11 @@ def tip_contact(
         v_WT: tip translational velocity in W, m/s (3,).
         p_WPh: phantom body origin in W (its map offset plus lift), m (3,).
         v_WPh: phantom body translational velocity in W, m/s (3,).
+        friction_coefficient: mu of an optional sliding friction in the
+            horizontal plane, ``-mu F v_t / sqrt(|v_t|^2 + v_s^2)`` with v_t
+            the tip's horizontal velocity relative to the phantom and F the
+            Hunt-Crossley force (0: none, the paper's model).
+        slip_speed_m_per_s: v_s, the regularisation speed of that friction.
 
     Returns:
         The :class:`TipContact` (see the module docstring for the formulas).
@@ -167,7 +182,14 @@ def tip_contact(
     force = float(
         hunt_crossley_force(eps, eps_dot, s.kappa, s.lam, phantom.beta, clip_tension=True)
     )
-    return TipContact(force, float(eps), float(eps_dot), surface, float(s.kappa), float(s.lam))
+    fx = fy = 0.0
+    if friction_coefficient > 0.0 and force > 0.0:
+        vx, vy = float(v_rel[0]), float(v_rel[1])
+        scale = -friction_coefficient * force / np.sqrt(vx * vx + vy * vy + slip_speed_m_per_s**2)
+        fx, fy = scale * vx, scale * vy
+    return TipContact(
+        force, float(eps), float(eps_dot), surface, float(s.kappa), float(s.lam), fx, fy
+    )
 
 
 def _cross(a, b) -> np.ndarray:
@@ -189,7 +211,8 @@ class TissueForceElement(LeafSystem):
         spatial_forces: ``list[ExternallyAppliedSpatialForce]`` -- +F on the
             indenter at the tip, -F on the phantom body; connect to the
             plant's applied spatial force input.
-        force_W: (3,) true tissue force on the tip in W, N (z >= 0 up).
+        force_W: (3,) true tissue force on the tip in W, N (z >= 0 up; x, y
+            the optional friction, else 0).
         penetration: (1,) eps, m.
         surface_z: (1,) tissue surface height under the tip in W, m.
 
@@ -205,6 +228,8 @@ class TissueForceElement(LeafSystem):
         p_BT,
         phantom_body_index: BodyIndex,
         lookup_resolution_m: float = 0.0005,
+        friction_coefficient: float = 0.0,
+        slip_speed_m_per_s: float = 0.005,
     ):
         """
         Args:
@@ -214,7 +239,17 @@ class TissueForceElement(LeafSystem):
             phantom_body_index: the phantom body (receives the reaction).
             lookup_resolution_m: grid of the per-step lookup for phantoms
                 that are not grids (see :class:`GridLookup`), m.
+            friction_coefficient, slip_speed_m_per_s: optional tangential
+                friction (see :func:`tip_contact`); 0 = the paper's model.
         """
+        if not (np.isfinite(friction_coefficient) and friction_coefficient >= 0):
+            raise VicDrakeError(
+                f"friction_coefficient must be >= 0, got {friction_coefficient!r}"
+            )
+        if not (np.isfinite(slip_speed_m_per_s) and slip_speed_m_per_s > 0):
+            raise VicDrakeError(f"slip_speed_m_per_s must be > 0, got {slip_speed_m_per_s!r}")
+        self._mu = float(friction_coefficient)
+        self._slip = float(slip_speed_m_per_s)
         super().__init__()
         self._phantom = GridLookup(phantom, resolution_m=lookup_resolution_m)
         self._indenter = indenter_body_index
@@ -290,15 +325,20 @@ class TissueForceElement(LeafSystem):
         v_WT = V_WB.translational() + _cross(V_WB.rotational(), p_BT_W)
         p_WPh = poses[int(self._phantom_body)].translation()
         V_WPh = velocities[int(self._phantom_body)]
-        contact = tip_contact(self._phantom, p_WT, v_WT, p_WPh, V_WPh.translational())
+        contact = tip_contact(
+            self._phantom, p_WT, v_WT, p_WPh, V_WPh.translational(),
+            friction_coefficient=self._mu, slip_speed_m_per_s=self._slip,
+        )
         value.set_value(_Cached(contact, p_WT, p_WPh))
 
     def _calc_force(self, context, output):
-        output.SetFromVector([0.0, 0.0, self._contact(context).force_N])
+        c = self._contact(context)
+        output.SetFromVector([c.friction_x_N, c.friction_y_N, c.force_N])
 
     def _calc_spatial_forces(self, context, output):
         cached = self._contact_cache.Eval(context)
-        f_W = np.array([0.0, 0.0, cached.contact.force_N])
+        c = cached.contact
+        f_W = np.array([c.friction_x_N, c.friction_y_N, c.force_N])
         on_tip = ExternallyAppliedSpatialForce()
         on_tip.body_index = self._indenter
         on_tip.p_BoBq_B = self._p_BT
