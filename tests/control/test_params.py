@@ -21,7 +21,7 @@ def test_defaults_are_the_real_controllers_settings():
     assert p.qp.stiffness_max_N_per_m == [1000.0, 1000.0, 1000.0]
     assert p.qp.q_weight == [3200.0] * 3
     assert p.qp.force_max_N == [15.0] * 3 and p.qp.force_min_N == [-15.0] * 3
-    assert p.qp.damping_ratio == 0.707
+    assert p.qp.damping_ratio == 0.707 and p.qp.solver == "osqp"
     assert (p.tank.initial_energy_J, p.tank.min_energy_J, p.tank.max_energy_J) == (
         0.5,
         0.4,

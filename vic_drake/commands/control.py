@@ -35,8 +35,9 @@ def register(subparsers) -> None:
     parser.add_argument(
         "--solver",
         choices=("osqp", "clarabel", "exact"),
-        default="exact",
-        help="QP solver (default: exact, the closed-form active-set solver)",
+        default="osqp",
+        help="QP solver: osqp (default) or clarabel through Drake's MathematicalProgram, "
+        "or exact, the closed-form solver (same answer, faster)",
     )
     add_json_option(parser)
     parser.set_defaults(handler=run_replay_qp)
