@@ -94,3 +94,15 @@ def test_yaml_round_trip():
     q = yaml_load_typed(schema=ControllerParams, data=text)
     assert q == p
     q.validate()
+
+
+def test_real_controller_params():
+    from vic_drake.control.params import real_controller_params
+
+    assert real_controller_params("vs-vf").qp.r_weight == [1e-5] * 3
+    assert real_controller_params("vs-cf").qp.r_weight == [0.1] * 3
+    assert (
+        real_controller_params("cs").reference.constant_stiffness_N_per_m == [400.0] * 3
+    )
+    with pytest.raises(VicDrakeError, match="'vs'"):
+        real_controller_params("vs")

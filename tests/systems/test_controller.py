@@ -4,12 +4,15 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from pydrake.systems.analysis import Simulator
 
 from vic_drake.control.params import (
     ControllerParams,
     ReferenceParams,
     StiffnessQpParams,
+    TankParams,
 )
 from vic_drake.control.stiffness_qp import (
     make_stiffness_qp_problem,
@@ -302,3 +305,50 @@ def test_built_diagram_ignores_later_edits_of_its_params(phantom):
     tick(diagram, context)
     k = out(diagram, context, "stiffness")
     assert k[2] < 900.0 and not np.allclose(k, 400.0)
+
+
+_step = st.tuples(
+    st.tuples(
+        st.floats(-0.004, 0.004), st.floats(-0.004, 0.004), st.floats(-0.004, 0.004)
+    ),
+    st.tuples(st.floats(-0.05, 0.05), st.floats(-0.05, 0.05), st.floats(-0.05, 0.05)),
+    st.floats(-12.0, 1.0),
+)
+
+
+@settings(max_examples=25, deadline=None)
+@given(steps=st.lists(_step, min_size=5, max_size=30), energy=st.floats(0.41, 0.6),
+       controller=st.sampled_from(["vs-cf", "vs-vf"]))  # fmt: skip
+def test_random_closed_sequences_keep_tank_and_bounds(
+    phantom, steps, energy, controller
+):
+    """Any measurement sequence: T >= T_min and K_min <= K <= K_max at every tick."""
+    params = ControllerParams(
+        qp=StiffnessQpParams(solver="exact", r_weight=[1e-5] * 3),
+        tank=TankParams(initial_energy_J=energy),
+        reference=ReferenceParams(controller=controller),
+    )
+    diagram = MakeVariableImpedanceController(params, phantom=phantom)
+    context = diagram.CreateDefaultContext()
+    diagram.GetInputPort("target_position").FixValue(context, X_D)
+    p = P_WP.copy()
+    k_lo, k_hi = (
+        np.array(params.qp.stiffness_min_N_per_m),
+        np.array(params.qp.stiffness_max_N_per_m),
+    )
+    for dp, v, fz in steps:
+        p = p + np.array(dp)
+        diagram.GetInputPort("ee_position").FixValue(context, p)
+        diagram.GetInputPort("ee_velocity").FixValue(context, np.array(v))
+        diagram.GetInputPort("measured_force").FixValue(context, [0.0, 0.0, fz])
+        tick(diagram, context)
+        tank = out(diagram, context, "tank")
+        k = out(diagram, context, "stiffness")
+        assert tank[0] >= params.tank.min_energy_J - 1e-12
+        assert (
+            tank[1] >= params.tank.power_limit_W - 1e-9
+            or tank[2] == 0.0
+            and tank[1] >= -1e-9
+        )
+        assert np.all(k >= k_lo - 1e-9) and np.all(k <= k_hi + 1e-9)
+        assert np.all(np.isfinite(out(diagram, context, "damping")))

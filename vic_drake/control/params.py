@@ -318,3 +318,23 @@ class ControllerParams:
                 )
             value.validate()
         return self
+
+
+def real_controller_params(controller: str) -> ControllerParams:
+    """The settings of the paper's real runs for one controller.
+
+    - "cs": 400 N/m on every axis (test_compliance_control400).
+    - "cf": 7 N pressing, x/y at 400 N/m (test_force_control).
+    - "vs-cf": 7 N reference, eps_max = 8 mm, R = 0.1 (test_tracking5).
+    - "vs-vf": eps_d = 8 mm, F_min,z = -9 N, R = 1e-5
+      (test_nardi_matForce_lowR).
+    """
+    if controller not in CONTROLLERS:
+        raise VicDrakeError(
+            f"controller must be one of {list(CONTROLLERS)}; got {controller!r}"
+        )
+    r = 1e-5 if controller == "vs-vf" else 0.1
+    return ControllerParams(
+        qp=StiffnessQpParams(r_weight=[r, r, r]),
+        reference=ReferenceParams(controller=controller),
+    )
