@@ -54,7 +54,12 @@ def tared_sensor_wrench(
     F_S = np.asarray(F_S, float)
     g_S = np.asarray(R_WS, float).T @ np.asarray(gravity_W, float)
     f_static = -distal_mass_kg * g_S  # the sensor holds the weight up
-    tau_static = np.cross(np.asarray(p_SScm, float), f_static)
+    p = np.asarray(p_SScm, float)
+    tau_static = np.array([  # p x f_static (np.cross is slow on 3-vectors)
+        p[1] * f_static[2] - p[2] * f_static[1],
+        p[2] * f_static[0] - p[0] * f_static[2],
+        p[0] * f_static[1] - p[1] * f_static[0],
+    ])
     return F_S - np.concatenate([tau_static, f_static])
 
 

@@ -179,9 +179,11 @@ def tip_contact(
     eps = surface - p_WT[2]
     v_rel = v_WT - v_WPh
     eps_dot = float(s.dz_dx) * v_rel[0] + float(s.dz_dy) * v_rel[1] - v_rel[2]
-    force = float(
-        hunt_crossley_force(eps, eps_dot, s.kappa, s.lam, phantom.beta, clip_tension=True)
-    )
+    force = 0.0  # out of contact (the law's value too; skips its numpy cost)
+    if eps > 0.0:
+        force = float(
+            hunt_crossley_force(eps, eps_dot, s.kappa, s.lam, phantom.beta, clip_tension=True)
+        )
     fx = fy = 0.0
     if friction_coefficient > 0.0 and force > 0.0:
         vx, vy = float(v_rel[0]), float(v_rel[1])
