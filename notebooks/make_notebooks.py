@@ -135,7 +135,7 @@ controllers = ("vs-vf", "cs") if SHORT else ("cs", "cf", "vs-cf", "vs-vf")
 runs = {}
 for c in controllers:
     scenario = scan_scenario(c, disturbed=False, phantom_kind=kind, quick=True)
-    runs[c] = run_scan(scenario, duration_s=4.0 if SHORT else None)
+    runs[c] = run_scan(scenario, duration_s=3.0 if SHORT else None)
     print(f"{c}: {runs[c].sim_s:.1f} s simulated in {runs[c].wall_s:.1f} s")"""
         ),
         new_markdown_cell("## Fig. 6: force, stiffness, penetration and tank"),
@@ -181,7 +181,7 @@ controllers = ("vs-vf",) if SHORT else ("vs-vf", "cs", "cf")
 runs = {}
 for c in controllers:
     scenario = scan_scenario(c, disturbed=True, phantom_kind=kind, quick=True)
-    runs[c] = run_scan(scenario, duration_s=7.0 if SHORT else None)
+    runs[c] = run_scan(scenario, duration_s=6.0 if SHORT else None)
     print(f"{c}: {runs[c].sim_s:.1f} s simulated in {runs[c].wall_s:.1f} s")"""
         ),
         new_code_cell(
@@ -240,7 +240,7 @@ if DATA is not None:
     from vic_drake.plots.scans import plot_comparison
 
     out, sim_df, real_df = compare_real(DATA / "experiments" / "test_nardi_matForce_lowR",
-                                        duration_s=4.0 if SHORT else None,
+                                        duration_s=3.0 if SHORT else None,
                                         return_frames=True)
     print({k: out[k] for k in ("controller", "force_rmse_N", "z_rmse_mm", "tank_min_J")})
     plot_comparison(sim_df, real_df, title="VS-VF: simulated vs real")"""

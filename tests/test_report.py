@@ -57,6 +57,7 @@ def test_format_value():
     assert format_value(0.0123456) == "0.01235"
     assert format_value({"a": 1, "b": [1.5, None]}) == "a: 1\nb: [1.5, —]"
     assert "n/a" in format_value(float("nan"))
+    assert format_value({"log": {"a": 1, "b": 2}, "c": 3}) == "log:\n  a: 1\n  b: 2\nc: 3"
 
 
 def test_render_without_claims():

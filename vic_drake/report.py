@@ -73,6 +73,7 @@ class ReportContent:
         metadata: {label: value} (versions, data folder, mode).
         stages: [{"name", "ok", "wall_s", "error"}] per pipeline stage.
         links: [(text, relative href)] (e.g. the Meshcat replay, logs).
+        notes: short remarks on how to read the results (a bullet list).
     """
 
     title: str = "vic_drake reproduction report"
@@ -83,6 +84,7 @@ class ReportContent:
     metadata: Mapping[str, Any] = field(default_factory=dict)
     stages: Sequence[Mapping[str, Any]] = field(default_factory=list)
     links: Sequence[tuple[str, str]] = field(default_factory=list)
+    notes: Sequence[str] = field(default_factory=list)
 
 
 _CSS = """
@@ -124,7 +126,14 @@ def format_value(value: Any) -> str:
     if isinstance(value, (float, np.floating)):
         return _fmt_number(float(value))
     if isinstance(value, Mapping):
-        return "\n".join(f"{k}: {format_value(v)}" for k, v in value.items())
+        lines = []
+        for k, v in value.items():
+            if isinstance(v, Mapping) and v:
+                inner = format_value(v).replace("\n", "\n  ")
+                lines.append(f"{k}:\n  {inner}")
+            else:
+                lines.append(f"{k}: {format_value(v)}")
+        return "\n".join(lines)
     if isinstance(value, (list, tuple)):
         return "[" + ", ".join(format_value(v) for v in value) + "]"
     return str(value)
@@ -199,6 +208,10 @@ def render_report(content: ReportContent) -> str:
             "and at least one side was evaluated; — = not evaluated (reason in the claim's "
             "note). The machine-readable table is claims.json.</p>"
         )
+    if content.notes:
+        parts.append("<h2>How to read this</h2><ul>")
+        parts.extend(f"<li>{html.escape(n)}</li>" for n in content.notes)
+        parts.append("</ul>")
     if content.tables:
         parts.append("<h2>Tables</h2>")
         parts.extend(table_html(t) for t in content.tables)

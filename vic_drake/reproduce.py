@@ -832,6 +832,28 @@ def _versions() -> dict:
     }
 
 
+REPORT_NOTES = (
+    "paper: the paper's number or statement; simulation: the same metric computed from "
+    "the logs of the Drake simulation; real measurement: the same metric on the paper's "
+    "own logs (../shared/data), where such a log exists.",
+    "C1 and C2 in simulation fit palpations simulated on a Hunt-Crossley tissue with "
+    "beta = 1.35: they test the estimation pipeline (sensor lag and noise, indenter mass, "
+    "contact selection), not whether tissue is Hunt-Crossley; the real logs test that.",
+    "C3 in simulation re-estimates the scan phantom's map from simulated palpations on "
+    "a 1 cm grid (with the paper's data, the phantom is the paper's measured map); the "
+    "real value is the paper's own GP map.",
+    "C4-C7 in simulation come from the scans of this run; the real values from the "
+    "paper's scan logs. The published data has no VS-VF disturbance log, so C7 has no "
+    "real value. The real CF reference (7 N) is not logged; it is taken from the "
+    "data's README.",
+    "The disturbance here is a scripted lift, drop below rest and return of the phantom "
+    "(vic_drake.reproduce.disturbance_lifts); the paper's was by hand, so peak forces "
+    "compare in order, not in value.",
+    "Quick mode scans 5 cm instead of 20 cm with one disturbance event; force ranges "
+    "(C5) and peak forces (C7) see less of the body than the full run.",
+)
+
+
 def stage_report(ctx: RunContext) -> dict:
     """report.html: claims, tables, figures, files, stage times, versions."""
     from vic_drake.report import ReportContent, write_report
@@ -871,6 +893,7 @@ def stage_report(ctx: RunContext) -> dict:
         },
         stages=[r.as_dict() for r in ctx.records],
         links=links,
+        notes=REPORT_NOTES,
     )
     path = write_report(content, ctx.out_dir / "report.html")
     return {"path": path}
