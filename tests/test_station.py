@@ -90,8 +90,8 @@ def test_static_press_sensor_reads_the_hunt_crossley_force_once(phantom):
     pen = station.GetOutputPort("tissue.penetration").Eval(context)[0]
     f_hc = station.GetOutputPort("tissue.force_W").Eval(context)
     f_ft = station.GetOutputPort("ft_sensor.force_W").Eval(context)
-    # The position servo yields under the load by well under a millimetre.
-    assert 0.009 < pen < 0.0101
+    # The servo (integral action) holds the pose; the phantom sinks ~4 um.
+    assert 0.0099 < pen < 0.01001
     assert f_hc[2] > 5.0
     # Tared sensor = minus the tissue force (sensor convention), and nothing
     # else pushes the tool: Drake contact of the indenter is filtered out.
