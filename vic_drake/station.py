@@ -46,6 +46,15 @@ torques as feed-forward (the UR controller compensates gravity itself).
 Effort limits are the URDF's (56, 56, 28, 12, 12, 12 N m). The servo lag
 matters: FDCC re-reads the measured joints every tick, and with an ideal
 servo the FZI gains' force loop is unstable against the sensor's 56 ms lag.
+
+Notes for users: the plant's output ports are sampled (Drake's default for
+discrete plants), so ``plant.contact_results`` and the reaction forces
+behind the F/T reading describe the last plant step -- take one step after
+setting a state by hand. The sensor noise comes from a ``RandomSource``
+whose seed lives in the Context (deterministic by default; call
+``diagram.SetRandomContext(context, RandomGenerator(seed))`` for another
+draw). Speed (``benchmarks/bench_station.py``): Python LeafSystems run every
+plant step (tissue force) and every 2 ms (sensor, servo filter, FDCC).
 """
 
 from __future__ import annotations
