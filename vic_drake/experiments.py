@@ -347,6 +347,10 @@ DEFAULT_CF_FORCE_N = 7.0
 #: FDCC z gains of the CS baseline: the paper kept the FDCC defaults
 #: (k_p = 0.05, k_d = 0.0005) for CS "due to instability problems".
 CS_FDCC_Z_GAINS = (0.05, 0.0005)
+#: The 9-column CS/CF logs pair each pose with the force read 28 ticks (at
+#: 500 Hz) later (data README); the simulated force is advanced by as much
+#: before the comparison (metrics.lead_force).
+REAL_SCAN_FORCE_DELAY_S = 28 * 0.002
 #: Period at which a logged target is resampled into scenario waypoints, s.
 #: The real target is piecewise linear with 1 cm/s slopes and one step
 #: (the lift-off); 20 ms keeps it to within 0.1 mm.
@@ -782,10 +786,7 @@ def compare_real(
     result = run_scan(
         scenario, phantom=phantom, duration_s=duration_s, progress=progress
     )
-    lead = 0.0
-    if raw.attrs["layout"] == "scan":  # Force logged 28 ticks after its pose.
-        st = scenario.station
-        lead = st.sensor_lag_samples * st.sensor_period_s
+    lead = REAL_SCAN_FORCE_DELAY_S if raw.attrs["layout"] == "scan" else 0.0
     metrics = compare_with_real(result.df, real, force_lead_s=lead)
     out = {
         "controller": scenario.controller.reference.controller,
