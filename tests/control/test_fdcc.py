@@ -134,7 +134,7 @@ def test_joint_limits_clamp(model, q_start):
 @pytest.mark.parametrize(
     "field, value",
     [("error_scale", 0.0), ("iterations", 0), ("p_gains", (1.0,) * 5),
-     ("velocity_decay", 1.5), ("d_gains", (-1.0,) * 6)],
+     ("velocity_decay", 1.5), ("d_gains", (-1.0,) * 6), ("pose_feedback", "target")],
 )
 def test_bad_params_name_the_field(field, value):
     with pytest.raises(VicDrakeError, match=field):

@@ -10,7 +10,11 @@ tick (500 Hz):
    (``link_mass_kg`` at each moving link's origin, inertia
    ``link_inertia_kg_m2``) and a unit mass and inertia at the end effector
    (the ``probe`` frame), as FZI's generic model -- takes the measured joint
-   positions (its velocities stay internal);
+   positions (its velocities stay internal). As in FZI's code the pose in
+   the first error is the model's pose after the previous step (the last
+   command: synchronising the joints does not refresh it), while H and J
+   are evaluated at the measured joints (``pose_feedback = "measured"``
+   uses the measured pose instead);
 2. for each of ``iterations`` internal steps of ``internal_period_s``:
 
    - the net Cartesian error, in W, ``net = [K (x_d - x) + (f_t - f_m);
@@ -78,6 +82,10 @@ class FdccParams:
     velocity_decay: float = 0.9  # Internal velocity factor per step (FZI: 10 % damping).
     # Target orientation of the probe frame, quaternion (w, x, y, z): pointing down.
     target_orientation_wxyz: tuple[float, float, float, float] = (0.0, 1.0, 0.0, 0.0)
+    # Pose in the Cartesian error: "command" (FZI: the model's pose after the
+    # previous tick's step, i.e. of the last command) or "measured" (of the
+    # synchronised measured joints). H and J use the measured joints in both.
+    pose_feedback: str = "command"
 
     def __post_init__(self):
         for name in ("period_s", "internal_period_s", "error_scale", "link_mass_kg",
@@ -92,6 +100,11 @@ class FdccParams:
         if not (0 < self.velocity_decay <= 1):
             raise VicDrakeError(
                 f"FdccParams.velocity_decay must be in (0, 1], got {self.velocity_decay!r}"
+            )
+        if self.pose_feedback not in ("command", "measured"):
+            raise VicDrakeError(
+                "FdccParams.pose_feedback must be 'command' or 'measured', got "
+                f"{self.pose_feedback!r}"
             )
         _check_vec("p_gains", self.p_gains, 6, nonneg=True)
         _check_vec("d_gains", self.d_gains, 6, nonneg=True)
@@ -250,9 +263,14 @@ def fdcc_step(
     d_gains = np.asarray(params.d_gains, float)
     R_d = params.R_WP_target if R_WP_target is None else R_WP_target
     K_rot = np.asarray(params.rotational_stiffness_Nm_per_rad, float)
+    # The pose in the error: FZI's is the model's pose after the previous
+    # internal step (the last command; synchronising the joints does not
+    # update it), or optionally the measured pose.
+    q_pose = q_prev if params.pose_feedback == "command" else q
     for _ in range(params.iterations):
         X_WP, H, J = model.dynamics(q)
-        err = net_cartesian_error(X_WP, x_d, R_d, K, K_rot, f_m, f_t)
+        X_pose = X_WP if q_pose is q else model.pose(q_pose)
+        err = net_cartesian_error(X_pose, x_d, R_d, K, K_rot, f_m, f_t)
         u = params.error_scale * (p_gains * err + d_gains * (err - err_prev) / dt)
         err_prev = err
         u_drake = np.concatenate([u[3:], u[:3]])  # [tau; f]
@@ -262,7 +280,7 @@ def fdcc_step(
         below, above = q_next < model.q_lower, q_next > model.q_upper
         q_next = np.clip(q_next, model.q_lower, model.q_upper)
         qd[(below & (qd < 0)) | (above & (qd > 0))] = 0.0
-        q = q_next
+        q = q_pose = q_next
     if not np.isfinite(np.concatenate([q, qd, err_prev])).all():
         return hold
     return FdccStep(q, qd, err_prev, True)
