@@ -139,3 +139,22 @@ def test_joint_limits_clamp(model, q_start):
 def test_bad_params_name_the_field(field, value):
     with pytest.raises(VicDrakeError, match=field):
         FdccParams(**{field: value})
+
+
+def test_compliance_equilibrium_against_a_spring(model, q_start):
+    """CS use: K = 400 N/m, target 1.5 cm into a 1500 N/m spring, no force
+    target: the probe settles where the spring force equals K (z - z_d)."""
+    params = FdccParams()
+    surface, k_spring, K = START[2] - 0.005, 1500.0, 400.0
+
+    def spring(p):
+        return np.array([0.0, 0.0, -k_spring * max(surface - p[2], 0.0)])
+
+    spring.target = np.zeros(3)
+    target = np.array([START[0], START[1], surface - 0.015])
+    q = _run(model, params, q_start, ticks=4000, target=target, stiffness=[K] * 3,
+             force_fn=spring, lag=28, servo_tau=0.03)
+    z = model.pose(q).translation()[2]
+    # Closed form: k_s (s - z) = K (z - z_d).
+    z_eq = (k_spring * surface + K * target[2]) / (k_spring + K)
+    assert z == pytest.approx(z_eq, abs=5e-5)
