@@ -202,9 +202,12 @@ class StationParams:
     friction_coefficient: float = 0.5  # Coulomb friction of the safety contact.
     robot_contact: bool = True  # Robot links and sensor collide with the phantom.
     # Optional sliding friction of the tissue on the tip (times the HC force);
-    # 0 = the paper's model. About 0.3 matches the real scans' |f_x| of 2 N.
+    # 0 = the paper's model. About 0.2 matches the real scans' x force offset.
     tissue_friction_coefficient: float = 0.0
     tissue_slip_speed_m_per_s: float = 0.005  # Regularisation speed of that friction, m/s.
+    # Tissue force along the surface normal (True) or vertical (False, the
+    # paper's 1-D model); the real scans' lateral forces follow the normal.
+    tissue_force_along_normal: bool = False
     # Grid of the force element's per-step lookup of non-grid phantoms, m
     # (a GridPhantom is looked up on its own grid).
     tissue_lookup_resolution_m: float = 0.0005
@@ -255,8 +258,11 @@ class StationParams:
                 f"StationParams.indenter_tip_radius_m ({self.indenter_tip_radius_m}) must be "
                 f"< indenter_length_m ({self.indenter_length_m})"
             )
-        if not isinstance(self.robot_contact, bool):
-            raise VicDrakeError(f"StationParams.robot_contact must be a bool, got {self.robot_contact!r}")
+        for name in ("robot_contact", "tissue_force_along_normal"):
+            if not isinstance(getattr(self, name), bool):
+                raise VicDrakeError(
+                    f"StationParams.{name} must be a bool, got {getattr(self, name)!r}"
+                )
 
     # Tool geometry used by several builders.
     @property
@@ -785,6 +791,7 @@ def MakeStation(
             lookup_resolution_m=params.tissue_lookup_resolution_m,
             friction_coefficient=params.tissue_friction_coefficient,
             slip_speed_m_per_s=params.tissue_slip_speed_m_per_s,
+            along_normal=params.tissue_force_along_normal,
         ),
     )
     builder.Connect(plant.get_body_poses_output_port(), tissue.get_body_poses_input_port())

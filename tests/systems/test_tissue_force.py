@@ -128,3 +128,12 @@ def test_optional_friction_opposes_sliding_and_scales_with_the_normal_force():
     assert c.friction_y_N == 0.0
     off = tip_contact(ph, [0, 0, 0.11], v, friction_coefficient=0.3)
     assert off.friction_x_N == 0.0
+
+
+def test_optional_force_along_the_surface_normal():
+    ph = _plane_phantom(gx=0.2, gy=-0.1)
+    vertical = tip_contact(ph, [0.0, 0.0, 0.09], np.zeros(3))
+    normal = tip_contact(ph, [0.0, 0.0, 0.09], np.zeros(3), along_normal=True)
+    assert normal.force_N == vertical.force_N > 0
+    np.testing.assert_allclose(normal.force_W, vertical.force_N * np.array([-0.2, 0.1, 1.0]))
+    np.testing.assert_allclose(vertical.force_W, [0.0, 0.0, vertical.force_N])

@@ -21,11 +21,20 @@ Geometry and signs (all in the world frame W = the rig's ``base_link``):
   beta, clip_tension=True)`` (zero out of contact, never pulling), applied
   along +z of W at T on the indenter body; the equal and opposite force acts
   on the phantom body at the same point. The map's kappa and lambda were
-  fitted to vertical indentations, so the force is vertical. An optional
-  regularised sliding friction in the horizontal plane (coefficient mu times
-  the Hunt-Crossley force) is off by default: the paper does not model it,
-  though the real scans' sensor x force (about 2 N at 7 N pressing while
-  sliding at 1 cm/s) suggests mu of about 0.3.
+  fitted to vertical indentations, so by default the force is vertical (the
+  paper's 1-D model). Two options, off by default, add the horizontal
+  forces the real scans show: ``along_normal`` tilts the force along the
+  surface normal, ``F (-dz/dx, -dz/dy, 1)`` (the real logs' lateral sensor
+  forces follow -0.6..-0.8 dz/dx F and +0.7..+1.0 dz/dy F in their frame,
+  see below), and a regularised sliding friction (coefficient mu times the
+  Hunt-Crossley force; the real scans' x force has an offset of about
+  1.4-1.6 N at 7 N pressing while sliding along -x at 1 cm/s: mu ~ 0.2).
+
+  Note on the real logs' sensor x, y columns: regressed on the map's slope
+  they behave as the external force expressed in the sensor frame S (when
+  the tool points down x_S = x_W, y_S = -y_W, z_S = -z_W), not as minus
+  the external force in W: the two agree in y and z and differ in the sign
+  of x.
 """
 
 from __future__ import annotations
@@ -58,6 +67,8 @@ class TipContact:
         lam: Hunt-Crossley viscosity at the tip, N s/m^(beta+1).
         friction_x_N, friction_y_N: optional tangential friction on the tip
             in W's x and y (zero unless a friction coefficient is set).
+        tilt_x_N, tilt_y_N: the horizontal part of a force along the surface
+            normal, ``-dz/dx F`` and ``-dz/dy F`` (zero for a vertical force).
     """
 
     force_N: float
@@ -68,6 +79,15 @@ class TipContact:
     lam: float
     friction_x_N: float = 0.0
     friction_y_N: float = 0.0
+    tilt_x_N: float = 0.0
+    tilt_y_N: float = 0.0
+
+    @property
+    def force_W(self) -> np.ndarray:
+        """The whole force on the tip in W, N: tilt + friction in x, y; HC in z."""
+        return np.array([
+            self.tilt_x_N + self.friction_x_N, self.tilt_y_N + self.friction_y_N, self.force_N
+        ])
 
 
 @dataclass(frozen=True)
@@ -150,6 +170,7 @@ def tip_contact(
     *,
     friction_coefficient: float = 0.0,
     slip_speed_m_per_s: float = 0.005,
+    along_normal: bool = False,
 ) -> TipContact:
     """Hunt-Crossley contact of the probe tip T with a translated phantom Ph.
 
@@ -165,6 +186,9 @@ def tip_contact(
             the tip's horizontal velocity relative to the phantom and F the
             Hunt-Crossley force (0: none, the paper's model).
         slip_speed_m_per_s: v_s, the regularisation speed of that friction.
+        along_normal: if True the force acts along the surface's (unnormalised)
+            normal ``F (-dz/dx, -dz/dy, 1)``, keeping the vertical component
+            the fitted law; else it is vertical (the paper's 1-D model).
 
     Returns:
         The :class:`TipContact` (see the module docstring for the formulas).
@@ -189,8 +213,11 @@ def tip_contact(
         vx, vy = float(v_rel[0]), float(v_rel[1])
         scale = -friction_coefficient * force / np.sqrt(vx * vx + vy * vy + slip_speed_m_per_s**2)
         fx, fy = scale * vx, scale * vy
+    tx = ty = 0.0
+    if along_normal and force > 0.0:
+        tx, ty = -float(s.dz_dx) * force, -float(s.dz_dy) * force
     return TipContact(
-        force, float(eps), float(eps_dot), surface, float(s.kappa), float(s.lam), fx, fy
+        force, float(eps), float(eps_dot), surface, float(s.kappa), float(s.lam), fx, fy, tx, ty
     )
 
 
@@ -213,8 +240,9 @@ class TissueForceElement(LeafSystem):
         spatial_forces: ``list[ExternallyAppliedSpatialForce]`` -- +F on the
             indenter at the tip, -F on the phantom body; connect to the
             plant's applied spatial force input.
-        force_W: (3,) true tissue force on the tip in W, N (z >= 0 up; x, y
-            the optional friction, else 0).
+        force_W: (3,) true tissue force on the tip in W, N (z >= 0 up, the
+            Hunt-Crossley law; x, y the optional normal tilt and friction,
+            else 0).
         penetration: (1,) eps, m.
         surface_z: (1,) tissue surface height under the tip in W, m.
 
@@ -232,6 +260,7 @@ class TissueForceElement(LeafSystem):
         lookup_resolution_m: float = 0.0005,
         friction_coefficient: float = 0.0,
         slip_speed_m_per_s: float = 0.005,
+        along_normal: bool = False,
     ):
         """
         Args:
@@ -243,6 +272,8 @@ class TissueForceElement(LeafSystem):
                 that are not grids (see :class:`GridLookup`), m.
             friction_coefficient, slip_speed_m_per_s: optional tangential
                 friction (see :func:`tip_contact`); 0 = the paper's model.
+            along_normal: force along the surface normal instead of
+                vertical (see :func:`tip_contact`).
         """
         if not (np.isfinite(friction_coefficient) and friction_coefficient >= 0):
             raise VicDrakeError(
@@ -251,6 +282,7 @@ class TissueForceElement(LeafSystem):
         if not (np.isfinite(slip_speed_m_per_s) and slip_speed_m_per_s > 0):
             raise VicDrakeError(f"slip_speed_m_per_s must be > 0, got {slip_speed_m_per_s!r}")
         self._mu = float(friction_coefficient)
+        self._along_normal = bool(along_normal)
         self._slip = float(slip_speed_m_per_s)
         super().__init__()
         self._phantom = GridLookup(phantom, resolution_m=lookup_resolution_m)
@@ -330,17 +362,16 @@ class TissueForceElement(LeafSystem):
         contact = tip_contact(
             self._phantom, p_WT, v_WT, p_WPh, V_WPh.translational(),
             friction_coefficient=self._mu, slip_speed_m_per_s=self._slip,
+            along_normal=self._along_normal,
         )
         value.set_value(_Cached(contact, p_WT, p_WPh))
 
     def _calc_force(self, context, output):
-        c = self._contact(context)
-        output.SetFromVector([c.friction_x_N, c.friction_y_N, c.force_N])
+        output.SetFromVector(self._contact(context).force_W)
 
     def _calc_spatial_forces(self, context, output):
         cached = self._contact_cache.Eval(context)
-        c = cached.contact
-        f_W = np.array([c.friction_x_N, c.friction_y_N, c.force_N])
+        f_W = cached.contact.force_W
         on_tip = ExternallyAppliedSpatialForce()
         on_tip.body_index = self._indenter
         on_tip.p_BoBq_B = self._p_BT
