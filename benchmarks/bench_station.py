@@ -53,25 +53,37 @@ def _with_fdcc(params, phantom, *, stiffness, target_dz, target_force):
     s = float(phantom.surface_z(*XY))
     q = initial_q_for_tip([*XY, s + 0.005], params)
     builder = DiagramBuilder()
-    station = builder.AddNamedSystem("station", MakeStation(params, phantom=phantom, initial_q=q))
+    station = builder.AddNamedSystem(
+        "station", MakeStation(params, phantom=phantom, initial_q=q)
+    )
     fdcc = builder.AddNamedSystem(
         "fdcc", FdccController(FdccParams(), station_params=params, initial_q=q)
     )
     demux = builder.AddSystem(Demultiplexer([6, 6]))
     builder.Connect(station.GetOutputPort("ur3e.state"), demux.get_input_port())
     builder.Connect(demux.get_output_port(0), fdcc.get_joint_positions_input_port())
-    builder.Connect(station.GetOutputPort("ft_sensor.force_W"), fdcc.get_measured_force_input_port())
-    builder.Connect(fdcc.get_position_command_output_port(),
-                    station.GetInputPort("ur3e.position_command"))
-    for port, value in ((fdcc.get_target_position_input_port(), [*XY, s + target_dz]),
-                        (fdcc.get_stiffness_input_port(), stiffness),
-                        (fdcc.get_target_force_input_port(), target_force),
-                        (station.GetInputPort("phantom.lift"), [0.0])):
+    builder.Connect(
+        station.GetOutputPort("ft_sensor.force_W"), fdcc.get_measured_force_input_port()
+    )
+    builder.Connect(
+        fdcc.get_position_command_output_port(),
+        station.GetInputPort("ur3e.position_command"),
+    )
+    for port, value in (
+        (fdcc.get_target_position_input_port(), [*XY, s + target_dz]),
+        (fdcc.get_stiffness_input_port(), stiffness),
+        (fdcc.get_target_force_input_port(), target_force),
+        (station.GetInputPort("phantom.lift"), [0.0]),
+    ):
         source = builder.AddSystem(ConstantVectorSource(np.asarray(value, float)))
         builder.Connect(source.get_output_port(), port)
     diagram = builder.Build()
     simulator = Simulator(diagram)
-    return simulator, station, station.GetMyContextFromRoot(simulator.get_mutable_context())
+    return (
+        simulator,
+        station,
+        station.GetMyContextFromRoot(simulator.get_mutable_context()),
+    )
 
 
 def _time(simulator, duration, profile_top=0):
@@ -87,31 +99,56 @@ def _time(simulator, duration, profile_top=0):
     report = ""
     if profiler:
         out = io.StringIO()
-        pstats.Stats(profiler, stream=out).sort_stats("tottime").print_stats(profile_top)
+        pstats.Stats(profiler, stream=out).sort_stats("tottime").print_stats(
+            profile_top
+        )
         report = out.getvalue()
     return wall, report
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--duration", type=float, default=3.0, help="simulated seconds per case")
-    parser.add_argument("--phantom", choices=("synthetic", "measured"), default="synthetic")
-    parser.add_argument("--no-robot-contact", action="store_true",
-                        help="filter the links' safety contact with the phantom")
-    parser.add_argument("--profile-top", type=int, default=15,
-                        help="cProfile entries to print for the fdcc_cf case (0: none)")
+    parser.add_argument(
+        "--duration", type=float, default=3.0, help="simulated seconds per case"
+    )
+    parser.add_argument(
+        "--phantom", choices=("synthetic", "measured"), default="synthetic"
+    )
+    parser.add_argument(
+        "--no-robot-contact",
+        action="store_true",
+        help="filter the links' safety contact with the phantom",
+    )
+    parser.add_argument(
+        "--profile-top",
+        type=int,
+        default=15,
+        help="cProfile entries to print for the fdcc_cf case (0: none)",
+    )
     args = parser.parse_args(argv)
     phantom = load_phantom(args.phantom)
     params = StationParams(robot_contact=not args.no_robot_contact)
-    print(f"phantom={args.phantom} robot_contact={params.robot_contact} "
-          f"time_step={params.time_step_s} s, {args.duration} s simulated per case")
+    print(
+        f"phantom={args.phantom} robot_contact={params.robot_contact} "
+        f"time_step={params.time_step_s} s, {args.duration} s simulated per case"
+    )
     cases = {
         "free": lambda: _station_only(params, phantom, -0.02),
         "press": lambda: _station_only(params, phantom, 0.01),
-        "fdcc_cf": lambda: _with_fdcc(params, phantom, stiffness=[300, 300, 0], target_dz=0.005,
-                                      target_force=[0, 0, -7.0]),
-        "fdcc_cs": lambda: _with_fdcc(params, phantom, stiffness=[400] * 3, target_dz=-0.015,
-                                      target_force=[0, 0, 0]),
+        "fdcc_cf": lambda: _with_fdcc(
+            params,
+            phantom,
+            stiffness=[300, 300, 0],
+            target_dz=0.005,
+            target_force=[0, 0, -7.0],
+        ),
+        "fdcc_cs": lambda: _with_fdcc(
+            params,
+            phantom,
+            stiffness=[400] * 3,
+            target_dz=-0.015,
+            target_force=[0, 0, 0],
+        ),
     }
     for name, make in cases.items():
         t0 = time.perf_counter()
@@ -121,8 +158,10 @@ def main(argv=None):
         wall, report = _time(simulator, args.duration, top)
         f = station.GetOutputPort("tissue.force_W").Eval(context)[2]
         fs = station.GetOutputPort("ft_sensor.force_W").Eval(context)[2]
-        print(f"{name:8s} build {build:5.2f} s  wall {wall:6.2f} s  RTF {args.duration / wall:5.2f}"
-              f"  tissue force {f:6.2f} N  sensor z {fs:6.2f} N")
+        print(
+            f"{name:8s} build {build:5.2f} s  wall {wall:6.2f} s  RTF {args.duration / wall:5.2f}"
+            f"  tissue force {f:6.2f} N  sensor z {fs:6.2f} N"
+        )
         if report:
             print(report)
 

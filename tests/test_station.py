@@ -17,14 +17,29 @@ from vic_drake.tissue import SyntheticChestPhantom
 
 INPUTS = ("ur3e.position_command", "phantom.lift")
 OUTPUTS = (
-    "ur3e.state", "ft_sensor.force_W", "ft_sensor.wrench_S", "probe.position",
-    "probe.velocity", "tissue.force_W", "tissue.penetration", "tissue.surface_z",
+    "ur3e.state",
+    "ft_sensor.force_W",
+    "ft_sensor.wrench_S",
+    "probe.position",
+    "probe.velocity",
+    "tissue.force_W",
+    "tissue.penetration",
+    "tissue.surface_z",
     "phantom.z_offset",
 )
-SIZES = {"ur3e.position_command": 6, "phantom.lift": 1, "ur3e.state": 12,
-         "ft_sensor.force_W": 3, "ft_sensor.wrench_S": 6, "probe.position": 3,
-         "probe.velocity": 3, "tissue.force_W": 3, "tissue.penetration": 1,
-         "tissue.surface_z": 1, "phantom.z_offset": 1}
+SIZES = {
+    "ur3e.position_command": 6,
+    "phantom.lift": 1,
+    "ur3e.state": 12,
+    "ft_sensor.force_W": 3,
+    "ft_sensor.wrench_S": 6,
+    "probe.position": 3,
+    "probe.velocity": 3,
+    "tissue.force_W": 3,
+    "tissue.penetration": 1,
+    "tissue.surface_z": 1,
+    "phantom.z_offset": 1,
+}
 
 XY = (-0.06, -0.36)
 
@@ -73,8 +88,13 @@ def test_unreachable_tip_is_a_clear_error():
 
 @pytest.mark.parametrize(
     "field, value",
-    [("time_step_s", 0.0), ("sensor_lag_samples", -2), ("joint_kp_Nm_per_rad", (1.0,) * 5),
-     ("contact_approximation", "tamsi"), ("sensor_noise_std_N", (0, 0, -1))],
+    [
+        ("time_step_s", 0.0),
+        ("sensor_lag_samples", -2),
+        ("joint_kp_Nm_per_rad", (1.0,) * 5),
+        ("contact_approximation", "tamsi"),
+        ("sensor_noise_std_N", (0, 0, -1)),
+    ],
 )
 def test_bad_params_name_the_field(field, value):
     with pytest.raises(VicDrakeError, match=field):
@@ -102,7 +122,9 @@ def test_static_press_sensor_reads_the_hunt_crossley_force_once(phantom):
 
 
 def test_sensor_lags_the_tissue_force_by_the_set_samples(phantom):
-    station, context, _ = _pressing_station(phantom, 0.005, sensor_noise_std_N=(0.0, 0.0, 0.0))
+    station, context, _ = _pressing_station(
+        phantom, 0.005, sensor_noise_std_N=(0.0, 0.0, 0.0)
+    )
     simulator = Simulator(station, context)
     simulator.AdvanceTo(0.2)
     # Lift the phantom by 3 mm; the true force rises at once, the reading 28
@@ -115,7 +137,9 @@ def test_sensor_lags_the_tissue_force_by_the_set_samples(phantom):
         f_hc.append(station.GetOutputPort("tissue.force_W").Eval(context)[2])
         f_ft.append(-station.GetOutputPort("ft_sensor.force_W").Eval(context)[2])
     f_hc, f_ft = np.array(f_hc), np.array(f_ft)
-    assert station.GetOutputPort("phantom.z_offset").Eval(context)[0] == pytest.approx(0.003, abs=2e-4)
+    assert station.GetOutputPort("phantom.z_offset").Eval(context)[0] == pytest.approx(
+        0.003, abs=2e-4
+    )
     lags = range(0, 50)
     err = [np.sum((f_ft[k:] - f_hc[: len(f_hc) - k]) ** 2) for k in lags]
     assert abs(int(np.argmin(err)) - 28) <= 1
@@ -129,16 +153,21 @@ def test_phantom_volume_mesh_is_valid_and_follows_the_surface(phantom):
     volumes = np.einsum("ij,ij->i", np.cross(b - a, c - a), d - a) / 6
     assert np.all(volumes > 0)
     x_min, x_max, y_min, y_max = phantom.bounds
-    top = vertices[np.isclose(vertices[:, 2], phantom.surface_z(vertices[:, 0], vertices[:, 1]))]
+    top = vertices[
+        np.isclose(vertices[:, 2], phantom.surface_z(vertices[:, 0], vertices[:, 1]))
+    ]
     assert len(top) >= ((x_max - x_min) / 0.03) * ((y_max - y_min) / 0.03)
     # The slab's volume is the integral of its height.
     footprint = (x_max - x_min) * (y_max - y_min)
     # (the grid mean of the height weights the edges like the interior: ~3 %)
-    assert volumes.sum() == pytest.approx(footprint * (np.mean(top[:, 2]) - vertices[:, 2].min()),
-                                          rel=0.05)
+    assert volumes.sum() == pytest.approx(
+        footprint * (np.mean(top[:, 2]) - vertices[:, 2].min()), rel=0.05
+    )
     # A closed boundary: every edge of the surface is shared by two faces.
     faces = boundary_triangles(vertices, tets)
-    edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
+    edges = np.sort(
+        np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1
+    )
     _, counts = np.unique(edges, axis=0, return_counts=True)
     assert np.all(counts == 2)
 

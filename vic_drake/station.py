@@ -142,7 +142,9 @@ def probe_down_rotation() -> RotationMatrix:
 def _vec(value, n, name):
     a = np.asarray(value, float)
     if a.shape != (n,) or not np.all(np.isfinite(a)):
-        raise VicDrakeError(f"StationParams.{name} must be {n} finite numbers, got {value!r}")
+        raise VicDrakeError(
+            f"StationParams.{name} must be {n} finite numbers, got {value!r}"
+        )
     return a
 
 
@@ -164,7 +166,14 @@ class StationParams:
     # Stiffness per joint, N m/rad: with the gravity feed-forward alone (no
     # integral) a 9 N tip load leaves 0.4 mm of static error; the servo's
     # integral action removes it.
-    joint_kp_Nm_per_rad: tuple[float, ...] = (8000.0, 8000.0, 4000.0, 1000.0, 1000.0, 1000.0)
+    joint_kp_Nm_per_rad: tuple[float, ...] = (
+        8000.0,
+        8000.0,
+        4000.0,
+        1000.0,
+        1000.0,
+        1000.0,
+    )
     # Damping per joint, N m s/rad (about critical for the arm's inertia).
     joint_kd_Nms_per_rad: tuple[float, ...] = (120.0, 120.0, 60.0, 8.0, 8.0, 8.0)
     command_period_s: float = 0.002  # Period of the position command (500 Hz), s.
@@ -177,7 +186,9 @@ class StationParams:
     # -- BOTA SensONE F/T sensor ---------------------------------------------
     ft_mount_mass_kg: float = 0.149  # Mounting-side mass, kg.
     ft_wrench_mass_kg: float = 0.081  # Wrench-side mass, kg.
-    ft_wrench_offset_m: float = 0.035  # Wrench frame S from the mounting face along z, m.
+    ft_wrench_offset_m: float = (
+        0.035  # Wrench frame S from the mounting face along z, m.
+    )
     ft_radius_m: float = 0.04  # Housing radius (geometry and inertia), m.
     sensor_period_s: float = 0.002  # Sampling period, s (500 Hz).
     sensor_lag_samples: int = 28  # Reading delay, samples (56 ms at 500 Hz).
@@ -190,21 +201,31 @@ class StationParams:
     indenter_length_m: float = 0.07  # Probe tip from the wrench frame along z, m.
     indenter_tip_radius_m: float = 0.02  # Radius of the spherical tip, m.
     # -- phantom ----------------------------------------------------------------
-    phantom_offset_m: tuple[float, float, float] = (0.0, 0.0, 0.0)  # Map frame in W at zero lift, m.
+    phantom_offset_m: tuple[float, float, float] = (
+        0.0,
+        0.0,
+        0.0,
+    )  # Map frame in W at zero lift, m.
     phantom_mass_kg: float = 5.0  # Mass of the lifted phantom, kg.
-    phantom_kp_N_per_m: float = 2.0e6  # Lift servo stiffness, N/m (sinks 4 um under 8 N).
+    phantom_kp_N_per_m: float = (
+        2.0e6  # Lift servo stiffness, N/m (sinks 4 um under 8 N).
+    )
     phantom_kd_Ns_per_m: float = 6.0e3  # Lift servo damping, N s/m (about critical).
     phantom_mesh_resolution_m: float = 0.015  # Grid spacing of the contact mesh, m.
     phantom_thickness_m: float = 0.05  # Slab below the lowest surface point, m.
     hydroelastic_modulus_Pa: float = 1.0e5  # Phantom's hydroelastic modulus, Pa.
-    hydroelastic_resolution_hint_m: float = 0.03  # Tessellation of rigid link shapes, m.
+    hydroelastic_resolution_hint_m: float = (
+        0.03  # Tessellation of rigid link shapes, m.
+    )
     hunt_crossley_dissipation_s_per_m: float = 5.0  # Drake contact dissipation, s/m.
     friction_coefficient: float = 0.5  # Coulomb friction of the safety contact.
     robot_contact: bool = True  # Robot links and sensor collide with the phantom.
     # Optional sliding friction of the tissue on the tip (times the HC force);
     # 0 = the paper's model. About 0.2 matches the real scans' x force offset.
     tissue_friction_coefficient: float = 0.0
-    tissue_slip_speed_m_per_s: float = 0.005  # Regularisation speed of that friction, m/s.
+    tissue_slip_speed_m_per_s: float = (
+        0.005  # Regularisation speed of that friction, m/s.
+    )
     # Tissue force along the surface normal (True) or vertical (False, the
     # paper's 1-D model); the real scans' lateral forces follow the normal.
     tissue_force_along_normal: bool = False
@@ -214,25 +235,51 @@ class StationParams:
 
     def __post_init__(self):
         positive = (
-            "time_step_s", "gravity_m_per_s2", "command_period_s", "servo_time_constant_s", "ft_mount_mass_kg",
-            "ft_wrench_mass_kg", "ft_wrench_offset_m", "ft_radius_m", "sensor_period_s",
-            "indenter_mass_kg", "indenter_length_m", "indenter_tip_radius_m",
-            "phantom_mass_kg", "phantom_kp_N_per_m", "phantom_mesh_resolution_m",
-            "phantom_thickness_m", "hydroelastic_modulus_Pa",
-            "hydroelastic_resolution_hint_m", "tissue_lookup_resolution_m",
+            "time_step_s",
+            "gravity_m_per_s2",
+            "command_period_s",
+            "servo_time_constant_s",
+            "ft_mount_mass_kg",
+            "ft_wrench_mass_kg",
+            "ft_wrench_offset_m",
+            "ft_radius_m",
+            "sensor_period_s",
+            "indenter_mass_kg",
+            "indenter_length_m",
+            "indenter_tip_radius_m",
+            "phantom_mass_kg",
+            "phantom_kp_N_per_m",
+            "phantom_mesh_resolution_m",
+            "phantom_thickness_m",
+            "hydroelastic_modulus_Pa",
+            "hydroelastic_resolution_hint_m",
+            "tissue_lookup_resolution_m",
             "tissue_slip_speed_m_per_s",
         )
         for name in positive:
             value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and np.isfinite(value) and value > 0):
-                raise VicDrakeError(f"StationParams.{name} must be a number > 0, got {value!r}")
-        nonneg = ("servo_integral_time_s", "sensor_torque_noise_std_Nm", "phantom_kd_Ns_per_m",
-                  "hunt_crossley_dissipation_s_per_m", "friction_coefficient",
-                  "tissue_friction_coefficient")
+            if not (
+                isinstance(value, (int, float)) and np.isfinite(value) and value > 0
+            ):
+                raise VicDrakeError(
+                    f"StationParams.{name} must be a number > 0, got {value!r}"
+                )
+        nonneg = (
+            "servo_integral_time_s",
+            "sensor_torque_noise_std_Nm",
+            "phantom_kd_Ns_per_m",
+            "hunt_crossley_dissipation_s_per_m",
+            "friction_coefficient",
+            "tissue_friction_coefficient",
+        )
         for name in nonneg:
             value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and np.isfinite(value) and value >= 0):
-                raise VicDrakeError(f"StationParams.{name} must be a number >= 0, got {value!r}")
+            if not (
+                isinstance(value, (int, float)) and np.isfinite(value) and value >= 0
+            ):
+                raise VicDrakeError(
+                    f"StationParams.{name} must be a number >= 0, got {value!r}"
+                )
         if self.contact_approximation not in ("sap", "lagged"):
             raise VicDrakeError(
                 "StationParams.contact_approximation must be 'sap' or 'lagged', got "
@@ -247,12 +294,16 @@ class StationParams:
             )
         noise = _vec(self.sensor_noise_std_N, 3, "sensor_noise_std_N")
         if np.any(noise < 0):
-            raise VicDrakeError(f"StationParams.sensor_noise_std_N must be >= 0, got {self.sensor_noise_std_N!r}")
+            raise VicDrakeError(
+                f"StationParams.sensor_noise_std_N must be >= 0, got {self.sensor_noise_std_N!r}"
+            )
         _vec(self.sensor_bias_N, 3, "sensor_bias_N")
         _vec(self.phantom_offset_m, 3, "phantom_offset_m")
         lag = self.sensor_lag_samples
         if isinstance(lag, bool) or not isinstance(lag, (int, np.integer)) or lag < 0:
-            raise VicDrakeError(f"StationParams.sensor_lag_samples must be an integer >= 0, got {lag!r}")
+            raise VicDrakeError(
+                f"StationParams.sensor_lag_samples must be an integer >= 0, got {lag!r}"
+            )
         if self.indenter_tip_radius_m >= self.indenter_length_m:
             raise VicDrakeError(
                 f"StationParams.indenter_tip_radius_m ({self.indenter_tip_radius_m}) must be "
@@ -343,19 +394,22 @@ def AddTool(
     p = params
     half = p.ft_wrench_offset_m / 2
     mount = plant.AddRigidBody(
-        "ft_sensor_mount", tool,
+        "ft_sensor_mount",
+        tool,
         _cylinder_inertia(p.ft_mount_mass_kg, p.ft_radius_m, half, [0, 0, half / 2]),
     )
     plant.WeldFrames(
         plant.GetFrameByName("wrist_3_link", ur3e), mount.body_frame(), p.X_W3M
     )
     wrench = plant.AddRigidBody(
-        "ft_sensor_wrench", tool,
+        "ft_sensor_wrench",
+        tool,
         _cylinder_inertia(p.ft_wrench_mass_kg, p.ft_radius_m, half, [0, 0, -half / 2]),
     )
     mount_S = plant.AddFrame(
         FixedOffsetFrame(
-            "ft_sensor_wrench_on_mount", mount.body_frame(),
+            "ft_sensor_wrench_on_mount",
+            mount.body_frame(),
             RigidTransform([0, 0, p.ft_wrench_offset_m]),
         )
     )
@@ -371,8 +425,14 @@ def AddTool(
         FixedOffsetFrame("probe", indenter.body_frame(), RigidTransform([0, 0, L]))
     )
     handles = ArmHandles(
-        plant=plant, ur3e=ur3e, tool=tool, probe_frame=probe, sensor_weld=weld,
-        sensor_body=wrench, indenter_body=indenter, mount_body=mount,
+        plant=plant,
+        ur3e=ur3e,
+        tool=tool,
+        probe_frame=probe,
+        sensor_weld=weld,
+        sensor_body=wrench,
+        indenter_body=indenter,
+        mount_body=mount,
     )
     if with_geometry and plant.geometry_source_is_registered():
         grey, blue = np.array([0.3, 0.3, 0.3, 1.0]), np.array([0.2, 0.4, 0.9, 1.0])
@@ -380,7 +440,12 @@ def AddTool(
         shapes = {
             "mount": (mount, housing, RigidTransform([0, 0, half / 2]), grey),
             "wrench": (wrench, housing, RigidTransform([0, 0, -half / 2]), grey),
-            "indenter_cone": (indenter, Cylinder(r, L - r), RigidTransform([0, 0, (L - r) / 2]), blue),
+            "indenter_cone": (
+                indenter,
+                Cylinder(r, L - r),
+                RigidTransform([0, 0, (L - r) / 2]),
+                blue,
+            ),
             "indenter_tip": (indenter, Sphere(r), RigidTransform([0, 0, L - r]), blue),
         }
         for name, (body, shape, X_BG, color) in shapes.items():
@@ -388,8 +453,10 @@ def AddTool(
             props = ProximityProperties()
             AddRigidHydroelasticProperties(p.hydroelastic_resolution_hint_m, props)
             AddContactMaterial(
-                p.hunt_crossley_dissipation_s_per_m, None,
-                CoulombFriction(p.friction_coefficient, p.friction_coefficient), props,
+                p.hunt_crossley_dissipation_s_per_m,
+                None,
+                CoulombFriction(p.friction_coefficient, p.friction_coefficient),
+                props,
             )
             handles.tool_geometries[name] = plant.RegisterCollisionGeometry(
                 body, X_BG, shape, f"{name}_collision", props
@@ -452,7 +519,9 @@ def solve_tip_ik(
     seeds = [DEFAULT_Q_SEED, *FALLBACK_Q_SEEDS] if q_seed is None else [q_seed]
     seeds = [np.asarray(seed, float) for seed in seeds]
     if seeds[0].shape != (6,) or not np.all(np.isfinite(seeds[0])):
-        raise VicDrakeError(f"q_seed must be 6 finite joint angles (rad), got {q_seed!r}")
+        raise VicDrakeError(
+            f"q_seed must be 6 finite joint angles (rad), got {q_seed!r}"
+        )
     plant, handles = MakeUr3ePlant(params)
     R_WP = R_WP or probe_down_rotation()
     ik = InverseKinematics(plant)
@@ -461,7 +530,11 @@ def solve_tip_ik(
         handles.probe_frame, np.zeros(3), plant.world_frame(), p_WP - tol, p_WP + tol
     )
     ik.AddOrientationConstraint(
-        plant.world_frame(), R_WP, handles.probe_frame, RotationMatrix(), angle_tolerance_rad
+        plant.world_frame(),
+        R_WP,
+        handles.probe_frame,
+        RotationMatrix(),
+        angle_tolerance_rad,
     )
     prog = ik.get_mutable_prog()
     q = ik.q()
@@ -529,18 +602,32 @@ class JointCommandFilter(LeafSystem):
     :meth:`set_state` when starting elsewhere than ``initial_q``.
     """
 
-    def __init__(self, n: int, period_s: float, time_constant_s: float, initial_q,
-                 integral_time_s: float = 0.0):
+    def __init__(
+        self,
+        n: int,
+        period_s: float,
+        time_constant_s: float,
+        initial_q,
+        integral_time_s: float = 0.0,
+    ):
         super().__init__()
-        self._n, self._period, self._tau = int(n), float(period_s), float(time_constant_s)
+        self._n, self._period, self._tau = (
+            int(n),
+            float(period_s),
+            float(time_constant_s),
+        )
         self._ti = float(integral_time_s)
         self._in = self.DeclareVectorInputPort("command", self._n)
         self._measured = self.DeclareVectorInputPort("measured_position", self._n)
         q0 = np.asarray(initial_q, float).reshape(self._n)
-        self._state = self.DeclareDiscreteState(np.concatenate([q0, np.zeros(2 * self._n)]))
+        self._state = self.DeclareDiscreteState(
+            np.concatenate([q0, np.zeros(2 * self._n)])
+        )
         self.DeclarePeriodicDiscreteUpdateEvent(self._period, 0.0, self._update)
         self.DeclareVectorOutputPort(
-            "desired_state", 2 * self._n, self._calc_desired,
+            "desired_state",
+            2 * self._n,
+            self._calc_desired,
             prerequisites_of_calc={self.xd_ticket()},
         )
 
@@ -586,10 +673,18 @@ class PointKinematics(LeafSystem):
         self._vels = self.DeclareAbstractInputPort(
             "body_spatial_velocities", AbstractValue.Make([SpatialVelocity()])
         )
-        self.DeclareVectorOutputPort("position", 3, self._calc_position,
-                                     prerequisites_of_calc={self._poses.ticket()})
-        self.DeclareVectorOutputPort("velocity", 3, self._calc_velocity,
-                                     prerequisites_of_calc={self.all_input_ports_ticket()})
+        self.DeclareVectorOutputPort(
+            "position",
+            3,
+            self._calc_position,
+            prerequisites_of_calc={self._poses.ticket()},
+        )
+        self.DeclareVectorOutputPort(
+            "velocity",
+            3,
+            self._calc_velocity,
+            prerequisites_of_calc={self.all_input_ports_ticket()},
+        )
 
     def _calc_position(self, context, output):
         output.SetFromVector(self._poses.Eval(context)[self._body] @ self._p_BQ)
@@ -599,23 +694,31 @@ class PointKinematics(LeafSystem):
         V_WB = self._vels.Eval(context)[self._body]
         p_BQ_W = X_WB.rotation() @ self._p_BQ
         w = V_WB.rotational()
-        output.SetFromVector(V_WB.translational() + np.array([
-            w[1] * p_BQ_W[2] - w[2] * p_BQ_W[1],
-            w[2] * p_BQ_W[0] - w[0] * p_BQ_W[2],
-            w[0] * p_BQ_W[1] - w[1] * p_BQ_W[0],
-        ]))
+        output.SetFromVector(
+            V_WB.translational()
+            + np.array(
+                [
+                    w[1] * p_BQ_W[2] - w[2] * p_BQ_W[1],
+                    w[2] * p_BQ_W[0] - w[0] * p_BQ_W[2],
+                    w[0] * p_BQ_W[1] - w[1] * p_BQ_W[0],
+                ]
+            )
+        )
 
 
 def _set_pd_gains(plant, joint_names, model, kp, kd):
     for name, p_gain, d_gain in zip(joint_names, kp, kd):
         joint = plant.GetJointByName(name, model)
         actuators = [
-            plant.get_joint_actuator(a) for a in plant.GetJointActuatorIndices(model)
+            plant.get_joint_actuator(a)
+            for a in plant.GetJointActuatorIndices(model)
             if plant.get_joint_actuator(a).joint().index() == joint.index()
         ]
         if len(actuators) != 1:
             raise VicDrakeError(f"joint {name!r} needs exactly one actuator")
-        actuators[0].set_controller_gains(PdControllerGains(p=float(p_gain), d=float(d_gain)))
+        actuators[0].set_controller_gains(
+            PdControllerGains(p=float(p_gain), d=float(d_gain))
+        )
 
 
 def _add_phantom(plant, params: StationParams, phantom: Phantom):
@@ -623,7 +726,8 @@ def _add_phantom(plant, params: StationParams, phantom: Phantom):
     x_min, x_max, y_min, y_max = phantom.bounds
     size = np.array([x_max - x_min, y_max - y_min, params.phantom_thickness_m])
     body = plant.AddRigidBody(
-        "phantom", model,
+        "phantom",
+        model,
         SpatialInertia(
             params.phantom_mass_kg,
             np.zeros(3),
@@ -631,7 +735,9 @@ def _add_phantom(plant, params: StationParams, phantom: Phantom):
         ),
     )
     frame_on_world = plant.AddFrame(
-        FixedOffsetFrame("phantom_base", plant.world_frame(), RigidTransform(params.phantom_offset_m))
+        FixedOffsetFrame(
+            "phantom_base", plant.world_frame(), RigidTransform(params.phantom_offset_m)
+        )
     )
     joint = plant.AddJoint(
         PrismaticJoint("phantom_lift", frame_on_world, body.body_frame(), [0, 0, 1])
@@ -641,7 +747,8 @@ def _add_phantom(plant, params: StationParams, phantom: Phantom):
         PdControllerGains(p=params.phantom_kp_N_per_m, d=params.phantom_kd_Ns_per_m)
     )
     vtk, obj = phantom_mesh_paths(
-        phantom, resolution_m=params.phantom_mesh_resolution_m,
+        phantom,
+        resolution_m=params.phantom_mesh_resolution_m,
         thickness_m=params.phantom_thickness_m,
     )
     props = ProximityProperties()
@@ -649,8 +756,10 @@ def _add_phantom(plant, params: StationParams, phantom: Phantom):
         params.phantom_mesh_resolution_m, params.hydroelastic_modulus_Pa, props
     )
     AddContactMaterial(
-        params.hunt_crossley_dissipation_s_per_m, None,
-        CoulombFriction(params.friction_coefficient, params.friction_coefficient), props,
+        params.hunt_crossley_dissipation_s_per_m,
+        None,
+        CoulombFriction(params.friction_coefficient, params.friction_coefficient),
+        props,
     )
     geometry = plant.RegisterCollisionGeometry(
         body, RigidTransform(), Mesh(str(vtk)), "phantom_collision", props
@@ -669,10 +778,16 @@ def _make_links_hydroelastic(plant, scene_graph, ur3e, params):
             props = ProximityProperties()
             AddRigidHydroelasticProperties(params.hydroelastic_resolution_hint_m, props)
             AddContactMaterial(
-                params.hunt_crossley_dissipation_s_per_m, None,
-                CoulombFriction(params.friction_coefficient, params.friction_coefficient), props,
+                params.hunt_crossley_dissipation_s_per_m,
+                None,
+                CoulombFriction(
+                    params.friction_coefficient, params.friction_coefficient
+                ),
+                props,
             )
-            scene_graph.AssignRole(plant.get_source_id(), gid, props, RoleAssign.kReplace)
+            scene_graph.AssignRole(
+                plant.get_source_id(), gid, props, RoleAssign.kReplace
+            )
             ids.append(gid)
     return ids
 
@@ -711,9 +826,13 @@ def MakeStation(
         plant.body_poses, plant.contact_results: for logging/visualization.
     """
     if not isinstance(params, StationParams):
-        raise VicDrakeError(f"params must be a StationParams, got {type(params).__name__}")
+        raise VicDrakeError(
+            f"params must be a StationParams, got {type(params).__name__}"
+        )
     if not isinstance(phantom, Phantom):
-        raise VicDrakeError(f"phantom must be a vic_drake.tissue.Phantom, got {type(phantom).__name__}")
+        raise VicDrakeError(
+            f"phantom must be a vic_drake.tissue.Phantom, got {type(phantom).__name__}"
+        )
     builder = DiagramBuilder()
     config = MultibodyPlantConfig(
         time_step=params.time_step_s,
@@ -727,22 +846,37 @@ def MakeStation(
     phantom_model, phantom_body, phantom_geometry = _add_phantom(plant, params, phantom)
     link_geometries = _make_links_hydroelastic(plant, scene_graph, ur3e, params)
     tool_geometries = list(arm.tool_geometries.values())
-    indenter_geometries = [arm.tool_geometries["indenter_cone"], arm.tool_geometries["indenter_tip"]]
+    indenter_geometries = [
+        arm.tool_geometries["indenter_cone"],
+        arm.tool_geometries["indenter_tip"],
+    ]
     filters = CollisionFilterDeclaration()
     # No self collision of the arm and tool (the URDF's primitives overlap).
     filters.ExcludeWithin(GeometrySet(link_geometries + tool_geometries))
     # The indenter's contact with tissue is the Hunt-Crossley element only.
-    filters.ExcludeBetween(GeometrySet(indenter_geometries), GeometrySet([phantom_geometry]))
+    filters.ExcludeBetween(
+        GeometrySet(indenter_geometries), GeometrySet([phantom_geometry])
+    )
     if not params.robot_contact:
-        filters.ExcludeBetween(GeometrySet(link_geometries + tool_geometries),
-                               GeometrySet([phantom_geometry]))
+        filters.ExcludeBetween(
+            GeometrySet(link_geometries + tool_geometries),
+            GeometrySet([phantom_geometry]),
+        )
     scene_graph.collision_filter_manager().Apply(filters)
     plant.Finalize()
-    _set_pd_gains(plant, UR3E_JOINTS, ur3e, params.joint_kp_Nm_per_rad, params.joint_kd_Nms_per_rad)
+    _set_pd_gains(
+        plant,
+        UR3E_JOINTS,
+        ur3e,
+        params.joint_kp_Nm_per_rad,
+        params.joint_kd_Nms_per_rad,
+    )
     if initial_q is not None:
         q0 = np.asarray(initial_q, float)
         if q0.shape != (6,) or not np.all(np.isfinite(q0)):
-            raise VicDrakeError(f"initial_q must be 6 finite joint angles (rad), got {initial_q!r}")
+            raise VicDrakeError(
+                f"initial_q must be 6 finite joint angles (rad), got {initial_q!r}"
+            )
         plant.SetDefaultPositions(ur3e, q0)
 
     # Position servo: the command, smoothed as the UR's servoj does, is the
@@ -751,34 +885,53 @@ def MakeStation(
     ur_measured = builder.AddNamedSystem("ur3e_state_demux", Demultiplexer([6, 6]))
     ur_filter = builder.AddNamedSystem(
         "ur3e_servo_filter",
-        JointCommandFilter(6, params.command_period_s, params.servo_time_constant_s, q_default,
-                           params.servo_integral_time_s),
+        JointCommandFilter(
+            6,
+            params.command_period_s,
+            params.servo_time_constant_s,
+            q_default,
+            params.servo_integral_time_s,
+        ),
     )
     builder.Connect(plant.get_state_output_port(ur3e), ur_measured.get_input_port())
-    builder.Connect(ur_measured.get_output_port(0), ur_filter.GetInputPort("measured_position"))
-    builder.Connect(ur_filter.get_output_port(), plant.get_desired_state_input_port(ur3e))
+    builder.Connect(
+        ur_measured.get_output_port(0), ur_filter.GetInputPort("measured_position")
+    )
+    builder.Connect(
+        ur_filter.get_output_port(), plant.get_desired_state_input_port(ur3e)
+    )
     builder.ExportInput(ur_filter.GetInputPort("command"), "ur3e.position_command")
     lift_interp = builder.AddNamedSystem(
         "phantom_lift_interpolator",
         StateInterpolatorWithDiscreteDerivative(1, params.command_period_s, True),
     )
-    builder.Connect(lift_interp.get_output_port(), plant.get_desired_state_input_port(phantom_model))
+    builder.Connect(
+        lift_interp.get_output_port(), plant.get_desired_state_input_port(phantom_model)
+    )
     builder.ExportInput(lift_interp.get_input_port(), "phantom.lift")
 
     # Gravity feed-forward (the UR controller's own gravity compensation, and
     # the phantom's weight held by its lift).
     gravity = builder.AddNamedSystem(
         "gravity_compensation",
-        InverseDynamics(plant, InverseDynamics.InverseDynamicsMode.kGravityCompensation),
+        InverseDynamics(
+            plant, InverseDynamics.InverseDynamicsMode.kGravityCompensation
+        ),
     )
-    builder.Connect(plant.get_state_output_port(), gravity.get_input_port_estimated_state())
+    builder.Connect(
+        plant.get_state_output_port(), gravity.get_input_port_estimated_state()
+    )
     nv = plant.num_velocities()
     for model, n in ((ur3e, 6), (phantom_model, 1)):
         select = np.zeros((n, nv))
         for row, a in enumerate(plant.GetJointActuatorIndices(model)):
             select[row, plant.get_joint_actuator(a).joint().velocity_start()] = 1.0
-        gain = builder.AddNamedSystem(f"{plant.GetModelInstanceName(model)}_gravity_ff", MatrixGain(select))
-        builder.Connect(gravity.get_output_port_generalized_force(), gain.get_input_port())
+        gain = builder.AddNamedSystem(
+            f"{plant.GetModelInstanceName(model)}_gravity_ff", MatrixGain(select)
+        )
+        builder.Connect(
+            gravity.get_output_port_generalized_force(), gain.get_input_port()
+        )
         builder.Connect(gain.get_output_port(), plant.get_actuation_input_port(model))
 
     # Hunt-Crossley tissue force on the tip.
@@ -786,7 +939,9 @@ def MakeStation(
     tissue = builder.AddNamedSystem(
         "tissue_force",
         TissueForceElement(
-            phantom, indenter_body_index=arm.indenter_body.index(), p_BT=p_IP,
+            phantom,
+            indenter_body_index=arm.indenter_body.index(),
+            p_BT=p_IP,
             phantom_body_index=phantom_body.index(),
             lookup_resolution_m=params.tissue_lookup_resolution_m,
             friction_coefficient=params.tissue_friction_coefficient,
@@ -794,19 +949,30 @@ def MakeStation(
             along_normal=params.tissue_force_along_normal,
         ),
     )
-    builder.Connect(plant.get_body_poses_output_port(), tissue.get_body_poses_input_port())
-    builder.Connect(plant.get_body_spatial_velocities_output_port(),
-                    tissue.get_body_spatial_velocities_input_port())
-    builder.Connect(tissue.get_spatial_forces_output_port(), plant.get_applied_spatial_force_input_port())
+    builder.Connect(
+        plant.get_body_poses_output_port(), tissue.get_body_poses_input_port()
+    )
+    builder.Connect(
+        plant.get_body_spatial_velocities_output_port(),
+        tissue.get_body_spatial_velocities_input_port(),
+    )
+    builder.Connect(
+        tissue.get_spatial_forces_output_port(),
+        plant.get_applied_spatial_force_input_port(),
+    )
     builder.ExportOutput(tissue.get_force_output_port(), "tissue.force_W")
     builder.ExportOutput(tissue.get_penetration_output_port(), "tissue.penetration")
     builder.ExportOutput(tissue.get_surface_z_output_port(), "tissue.surface_z")
 
     # F/T sensor from the weld's reaction.
     m_ws, m_i = params.ft_wrench_mass_kg, params.indenter_mass_kg
-    p_SScm = (m_ws * np.array([0, 0, -params.ft_wrench_offset_m / 4])
-              + m_i * np.array([0, 0, 0.4 * params.indenter_length_m])) / (m_ws + m_i)
-    noise_std = np.concatenate([np.full(3, params.sensor_torque_noise_std_Nm), params.sensor_noise_std_N])
+    p_SScm = (
+        m_ws * np.array([0, 0, -params.ft_wrench_offset_m / 4])
+        + m_i * np.array([0, 0, 0.4 * params.indenter_length_m])
+    ) / (m_ws + m_i)
+    noise_std = np.concatenate(
+        [np.full(3, params.sensor_torque_noise_std_Nm), params.sensor_noise_std_N]
+    )
     sensor = builder.AddNamedSystem(
         "ft_sensor",
         ForceTorqueSensor(
@@ -822,8 +988,12 @@ def MakeStation(
             gravity_W=[0, 0, -params.gravity_m_per_s2],
         ),
     )
-    builder.Connect(plant.get_reaction_forces_output_port(), sensor.get_reaction_forces_input_port())
-    builder.Connect(plant.get_body_poses_output_port(), sensor.get_body_poses_input_port())
+    builder.Connect(
+        plant.get_reaction_forces_output_port(), sensor.get_reaction_forces_input_port()
+    )
+    builder.Connect(
+        plant.get_body_poses_output_port(), sensor.get_body_poses_input_port()
+    )
     if np.any(noise_std > 0):
         noise = builder.AddNamedSystem(
             "ft_sensor_noise",
@@ -833,9 +1003,13 @@ def MakeStation(
     builder.ExportOutput(sensor.get_force_output_port(), "ft_sensor.force_W")
     builder.ExportOutput(sensor.get_wrench_output_port(), "ft_sensor.wrench_S")
 
-    probe = builder.AddNamedSystem("probe_kinematics", PointKinematics(arm.indenter_body.index(), p_IP))
+    probe = builder.AddNamedSystem(
+        "probe_kinematics", PointKinematics(arm.indenter_body.index(), p_IP)
+    )
     builder.Connect(plant.get_body_poses_output_port(), probe.get_input_port(0))
-    builder.Connect(plant.get_body_spatial_velocities_output_port(), probe.get_input_port(1))
+    builder.Connect(
+        plant.get_body_spatial_velocities_output_port(), probe.get_input_port(1)
+    )
     builder.ExportOutput(probe.GetOutputPort("position"), "probe.position")
     builder.ExportOutput(probe.GetOutputPort("velocity"), "probe.velocity")
 
@@ -844,7 +1018,9 @@ def MakeStation(
     builder.Connect(plant.get_state_output_port(phantom_model), demux.get_input_port())
     builder.ExportOutput(demux.get_output_port(0), "phantom.z_offset")
     builder.ExportOutput(plant.get_body_poses_output_port(), "plant.body_poses")
-    builder.ExportOutput(plant.get_contact_results_output_port(), "plant.contact_results")
+    builder.ExportOutput(
+        plant.get_contact_results_output_port(), "plant.contact_results"
+    )
 
     if meshcat is not None:
         from pydrake.visualization import AddDefaultVisualization
@@ -861,7 +1037,9 @@ def station_plant(station: Diagram) -> MultibodyPlant:
     return station.GetSubsystemByName("plant")
 
 
-def set_station_state(station: Diagram, station_context, q, *, phantom_lift_m: float = 0.0):
+def set_station_state(
+    station: Diagram, station_context, q, *, phantom_lift_m: float = 0.0
+):
     """Sets the arm at rest at q (6,) and the phantom at a lift, in a station context."""
     plant = station_plant(station)
     plant_context = station.GetMutableSubsystemContext(plant, station_context)

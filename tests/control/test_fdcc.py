@@ -21,7 +21,9 @@ def q_start():
     return initial_q_for_tip(START)
 
 
-def _run(model, params, q0, *, ticks, target, stiffness, force_fn, lag=0, servo_tau=None):
+def _run(
+    model, params, q0, *, ticks, target, stiffness, force_fn, lag=0, servo_tau=None
+):
     """Closed loop with a kinematic arm.
 
     The arm is where commanded (``servo_tau`` None) or follows the command
@@ -34,8 +36,15 @@ def _run(model, params, q0, *, ticks, target, stiffness, force_fn, lag=0, servo_
     for _ in range(ticks):
         forces.append(force_fn(model.pose(q_arm).translation()))
         step = fdcc_step(
-            model, params, q_measured=q_arm, q_command_prev=q, qdot=qd, last_error=err,
-            p_WP_target=target, stiffness=stiffness, measured_force=forces[-1 - lag],
+            model,
+            params,
+            q_measured=q_arm,
+            q_command_prev=q,
+            qdot=qd,
+            last_error=err,
+            p_WP_target=target,
+            stiffness=stiffness,
+            measured_force=forces[-1 - lag],
             target_force=force_fn.target,
         )
         assert step.ok
@@ -50,16 +59,26 @@ def _run(model, params, q0, *, ticks, target, stiffness, force_fn, lag=0, servo_
 def test_net_error_signs(model, q_start):
     X = model.pose(q_start)
     R = probe_down_rotation()
-    up = net_cartesian_error(X, X.translation() + [0, 0, 0.01], R, [100, 100, 100], [50] * 3,
-                             np.zeros(3), np.zeros(3))
+    up = net_cartesian_error(
+        X,
+        X.translation() + [0, 0, 0.01],
+        R,
+        [100, 100, 100],
+        [50] * 3,
+        np.zeros(3),
+        np.zeros(3),
+    )
     np.testing.assert_allclose(up[:3], [0, 0, 1.0], atol=1e-6)
     # Pressing harder (sensor -9 N) than the target (-7 N): the net force lifts.
-    press = net_cartesian_error(X, X.translation(), R, [0, 0, 0], [50] * 3,
-                                [0, 0, -9.0], [0, 0, -7.0])
+    press = net_cartesian_error(
+        X, X.translation(), R, [0, 0, 0], [50] * 3, [0, 0, -9.0], [0, 0, -7.0]
+    )
     np.testing.assert_allclose(press[:3], [0, 0, 2.0], atol=1e-6)
     # A target turned about +x of W gives a positive torque about x.
     R_turned = RotationMatrix.MakeXRotation(0.01) @ X.rotation()
-    rot = net_cartesian_error(X, X.translation(), R_turned, [0] * 3, [50] * 3, np.zeros(3), np.zeros(3))
+    rot = net_cartesian_error(
+        X, X.translation(), R_turned, [0] * 3, [50] * 3, np.zeros(3), np.zeros(3)
+    )
     np.testing.assert_allclose(rot[3:], [0.5, 0, 0], atol=1e-6)
 
 
@@ -71,18 +90,28 @@ def test_free_space_step_converges_with_tool_down(model, q_start):
         return np.zeros(3)
 
     no_force.target = np.zeros(3)
-    q = _run(model, params, q_start, ticks=3000, target=target, stiffness=[400] * 3,
-             force_fn=no_force)
+    q = _run(
+        model,
+        params,
+        q_start,
+        ticks=3000,
+        target=target,
+        stiffness=[400] * 3,
+        force_fn=no_force,
+    )
     X = model.pose(q)
     np.testing.assert_allclose(X.translation(), target, atol=2e-4)
-    np.testing.assert_allclose(X.rotation().matrix(), probe_down_rotation().matrix(), atol=1e-3)
+    np.testing.assert_allclose(
+        X.rotation().matrix(), probe_down_rotation().matrix(), atol=1e-3
+    )
 
 
 @pytest.mark.parametrize(
     "k_spring, lag, servo_tau", [(2000.0, 0, None), (800.0, 28, 0.03)]
 )
-def test_zero_stiffness_force_target_settles_on_a_spring(model, q_start, k_spring, lag,
-                                                         servo_tau):
+def test_zero_stiffness_force_target_settles_on_a_spring(
+    model, q_start, k_spring, lag, servo_tau
+):
     """A linear spring 5 mm below the start; the target is 7 N pressing.
 
     With the sensor's 28-sample lag the loop needs the arm's servo lag (the
@@ -98,8 +127,17 @@ def test_zero_stiffness_force_target_settles_on_a_spring(model, q_start, k_sprin
         return np.array([0.0, 0.0, -push_up])  # sensor convention
 
     spring.target = np.array([0.0, 0.0, -7.0])
-    q = _run(model, params, q_start, ticks=4000, target=START, stiffness=[300, 300, 0],
-             force_fn=spring, lag=lag, servo_tau=servo_tau)
+    q = _run(
+        model,
+        params,
+        q_start,
+        ticks=4000,
+        target=START,
+        stiffness=[300, 300, 0],
+        force_fn=spring,
+        lag=lag,
+        servo_tau=servo_tau,
+    )
     p = model.pose(q).translation()
     assert spring(p)[2] == pytest.approx(-7.0, abs=0.05)
     np.testing.assert_allclose(p[:2], START[:2], atol=1e-3)
@@ -109,9 +147,16 @@ def test_nan_input_holds_the_last_command(model, q_start):
     params = FdccParams()
     q_prev = q_start + 0.01
     step = fdcc_step(
-        model, params, q_measured=q_start, q_command_prev=q_prev, qdot=np.ones(6),
-        last_error=np.zeros(6), p_WP_target=START, stiffness=[300, 300, np.nan],
-        measured_force=np.zeros(3), target_force=np.zeros(3),
+        model,
+        params,
+        q_measured=q_start,
+        q_command_prev=q_prev,
+        qdot=np.ones(6),
+        last_error=np.zeros(6),
+        p_WP_target=START,
+        stiffness=[300, 300, np.nan],
+        measured_force=np.zeros(3),
+        target_force=np.zeros(3),
     )
     assert not step.ok
     np.testing.assert_array_equal(step.q_command, q_prev)
@@ -123,9 +168,16 @@ def test_joint_limits_clamp(model, q_start):
     q = q_start.copy()
     q[2] = model.q_upper[2] - 1e-4  # elbow at its +pi limit
     step = fdcc_step(
-        model, params, q_measured=q, q_command_prev=q, qdot=np.full(6, 10.0),
-        last_error=np.zeros(6), p_WP_target=START, stiffness=[300] * 3,
-        measured_force=np.zeros(3), target_force=np.zeros(3),
+        model,
+        params,
+        q_measured=q,
+        q_command_prev=q,
+        qdot=np.full(6, 10.0),
+        last_error=np.zeros(6),
+        p_WP_target=START,
+        stiffness=[300] * 3,
+        measured_force=np.zeros(3),
+        target_force=np.zeros(3),
     )
     assert step.ok and step.q_command[2] <= model.q_upper[2]
     assert step.qdot[2] == 0.0
@@ -133,8 +185,14 @@ def test_joint_limits_clamp(model, q_start):
 
 @pytest.mark.parametrize(
     "field, value",
-    [("error_scale", 0.0), ("iterations", 0), ("p_gains", (1.0,) * 5),
-     ("velocity_decay", 1.5), ("d_gains", (-1.0,) * 6), ("pose_feedback", "target")],
+    [
+        ("error_scale", 0.0),
+        ("iterations", 0),
+        ("p_gains", (1.0,) * 5),
+        ("velocity_decay", 1.5),
+        ("d_gains", (-1.0,) * 6),
+        ("pose_feedback", "target"),
+    ],
 )
 def test_bad_params_name_the_field(field, value):
     with pytest.raises(VicDrakeError, match=field):
@@ -152,8 +210,17 @@ def test_compliance_equilibrium_against_a_spring(model, q_start):
 
     spring.target = np.zeros(3)
     target = np.array([START[0], START[1], surface - 0.015])
-    q = _run(model, params, q_start, ticks=4000, target=target, stiffness=[K] * 3,
-             force_fn=spring, lag=28, servo_tau=0.03)
+    q = _run(
+        model,
+        params,
+        q_start,
+        ticks=4000,
+        target=target,
+        stiffness=[K] * 3,
+        force_fn=spring,
+        lag=28,
+        servo_tau=0.03,
+    )
     z = model.pose(q).translation()[2]
     # Closed form: k_s (s - z) = K (z - z_d).
     z_eq = (k_spring * surface + K * target[2]) / (k_spring + K)

@@ -29,26 +29,53 @@ def _fix_inputs(system, context, q, *, stiffness=(300.0, 300.0, 300.0)):
 
 def test_ports_and_one_tick_equals_the_pure_step(q_start):
     system = FdccController(FdccParams(), initial_q=q_start)
-    for name, size in [("joint_positions", 6), ("target_position", 3), ("stiffness", 3),
-                       ("measured_force", 3), ("target_force", 3)]:
+    for name, size in [
+        ("joint_positions", 6),
+        ("target_position", 3),
+        ("stiffness", 3),
+        ("measured_force", 3),
+        ("target_force", 3),
+    ]:
         assert system.GetInputPort(name).size() == size
     assert system.GetOutputPort("position_command").size() == 6
     context = system.CreateDefaultContext()
-    np.testing.assert_array_equal(system.get_position_command_output_port().Eval(context), q_start)
+    np.testing.assert_array_equal(
+        system.get_position_command_output_port().Eval(context), q_start
+    )
     _fix_inputs(system, context, q_start)
     context.SetDiscreteState(system.EvalUniquePeriodicDiscreteUpdate(context))
     # Second tick: the internal velocity from tick one moves the command.
     context.SetDiscreteState(system.EvalUniquePeriodicDiscreteUpdate(context))
     q_cmd = system.get_position_command_output_port().Eval(context)
-    kw = dict(p_WP_target=START + [0, 0, 0.01], stiffness=[300.0] * 3,
-              measured_force=[0, 0, -1.0], target_force=[0, 0, -2.0])
-    one = fdcc_step(system.model, system.params, q_measured=q_start, q_command_prev=q_start,
-                    qdot=np.zeros(6), last_error=np.zeros(6), **kw)
-    two = fdcc_step(system.model, system.params, q_measured=q_start,
-                    q_command_prev=one.q_command, qdot=one.qdot, last_error=one.last_error, **kw)
+    kw = dict(
+        p_WP_target=START + [0, 0, 0.01],
+        stiffness=[300.0] * 3,
+        measured_force=[0, 0, -1.0],
+        target_force=[0, 0, -2.0],
+    )
+    one = fdcc_step(
+        system.model,
+        system.params,
+        q_measured=q_start,
+        q_command_prev=q_start,
+        qdot=np.zeros(6),
+        last_error=np.zeros(6),
+        **kw,
+    )
+    two = fdcc_step(
+        system.model,
+        system.params,
+        q_measured=q_start,
+        q_command_prev=one.q_command,
+        qdot=one.qdot,
+        last_error=one.last_error,
+        **kw,
+    )
     np.testing.assert_allclose(q_cmd, two.q_command, atol=1e-15)
     assert not np.allclose(q_cmd, q_start)
-    np.testing.assert_array_equal(system.get_status_output_port().Eval(context), [0.0, 0.0])
+    np.testing.assert_array_equal(
+        system.get_status_output_port().Eval(context), [0.0, 0.0]
+    )
 
 
 def test_nan_input_holds_the_command_and_flags(q_start):
@@ -61,12 +88,18 @@ def test_nan_input_holds_the_command_and_flags(q_start):
     system.get_measured_force_input_port().FixValue(context, [0.0, np.nan, 0.0])
     for _ in range(3):
         context.SetDiscreteState(system.EvalUniquePeriodicDiscreteUpdate(context))
-    np.testing.assert_array_equal(system.get_position_command_output_port().Eval(context), held)
-    np.testing.assert_array_equal(system.get_status_output_port().Eval(context), [1.0, 3.0])
+    np.testing.assert_array_equal(
+        system.get_position_command_output_port().Eval(context), held
+    )
+    np.testing.assert_array_equal(
+        system.get_status_output_port().Eval(context), [1.0, 3.0]
+    )
     # Recovery: a finite input clears the flag, the count stays.
     system.get_measured_force_input_port().FixValue(context, [0.0, 0.0, -1.0])
     context.SetDiscreteState(system.EvalUniquePeriodicDiscreteUpdate(context))
-    np.testing.assert_array_equal(system.get_status_output_port().Eval(context), [0.0, 3.0])
+    np.testing.assert_array_equal(
+        system.get_status_output_port().Eval(context), [0.0, 3.0]
+    )
 
 
 def _closed_loop(q0, station_params, *, target, stiffness, target_force):
@@ -76,17 +109,25 @@ def _closed_loop(q0, station_params, *, target, stiffness, target_force):
         "station", MakeStation(station_params, phantom=phantom, initial_q=q0)
     )
     fdcc = builder.AddNamedSystem(
-        "fdcc", FdccController(FdccParams(), station_params=station_params, initial_q=q0)
+        "fdcc",
+        FdccController(FdccParams(), station_params=station_params, initial_q=q0),
     )
     demux = builder.AddSystem(Demultiplexer([6, 6]))
     builder.Connect(station.GetOutputPort("ur3e.state"), demux.get_input_port())
     builder.Connect(demux.get_output_port(0), fdcc.get_joint_positions_input_port())
-    builder.Connect(station.GetOutputPort("ft_sensor.force_W"), fdcc.get_measured_force_input_port())
-    builder.Connect(fdcc.get_position_command_output_port(), station.GetInputPort("ur3e.position_command"))
-    for port, value in ((fdcc.get_target_position_input_port(), target),
-                        (fdcc.get_stiffness_input_port(), stiffness),
-                        (fdcc.get_target_force_input_port(), target_force),
-                        (station.GetInputPort("phantom.lift"), [0.0])):
+    builder.Connect(
+        station.GetOutputPort("ft_sensor.force_W"), fdcc.get_measured_force_input_port()
+    )
+    builder.Connect(
+        fdcc.get_position_command_output_port(),
+        station.GetInputPort("ur3e.position_command"),
+    )
+    for port, value in (
+        (fdcc.get_target_position_input_port(), target),
+        (fdcc.get_stiffness_input_port(), stiffness),
+        (fdcc.get_target_force_input_port(), target_force),
+        (station.GetInputPort("phantom.lift"), [0.0]),
+    ):
         source = builder.AddSystem(ConstantVectorSource(np.asarray(value, float)))
         builder.Connect(source.get_output_port(), port)
     diagram = builder.Build()
@@ -100,7 +141,10 @@ def test_closed_loop_force_target_on_the_phantom():
     s = float(phantom.surface_z(*xy))
     q0 = initial_q_for_tip([*xy, s + 0.005])
     diagram, station = _closed_loop(
-        q0, StationParams(), target=[*xy, s + 0.005], stiffness=[300, 300, 0],
+        q0,
+        StationParams(),
+        target=[*xy, s + 0.005],
+        stiffness=[300, 300, 0],
         target_force=[0, 0, -7.0],
     )
     simulator = Simulator(diagram)

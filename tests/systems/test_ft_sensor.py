@@ -16,21 +16,31 @@ def test_tare_zeroes_the_static_load_in_any_orientation():
         R_WS = RotationMatrix(RollPitchYaw(rpy)).matrix()
         f_S = -m * (R_WS.T @ g)  # what the sensor applies to hold the mass still
         tau_S = np.cross(p_com, f_S)
-        out = tared_sensor_wrench(np.concatenate([tau_S, f_S]), R_WS, distal_mass_kg=m, p_SScm=p_com)
+        out = tared_sensor_wrench(
+            np.concatenate([tau_S, f_S]), R_WS, distal_mass_kg=m, p_SScm=p_com
+        )
         np.testing.assert_allclose(out, 0.0, atol=1e-12)
 
 
 def _sensor(**kw):
     return ForceTorqueSensor(
-        weld_joint_index=JointIndex(0), child_body_index=BodyIndex(1),
-        X_CS=RigidTransform(), distal_mass_kg=0.0, p_SScm=np.zeros(3), **kw,
+        weld_joint_index=JointIndex(0),
+        child_body_index=BodyIndex(1),
+        X_CS=RigidTransform(),
+        distal_mass_kg=0.0,
+        p_SScm=np.zeros(3),
+        **kw,
     )
 
 
 def _fix(system, context, f_S, R_WS=None):
     R_WS = R_WS or RotationMatrix()
-    system.get_reaction_forces_input_port().FixValue(context, [SpatialForce(np.zeros(3), f_S)])
-    system.get_body_poses_input_port().FixValue(context, [RigidTransform(), RigidTransform(R_WS, [0, 0, 0])])
+    system.get_reaction_forces_input_port().FixValue(
+        context, [SpatialForce(np.zeros(3), f_S)]
+    )
+    system.get_body_poses_input_port().FixValue(
+        context, [RigidTransform(), RigidTransform(R_WS, [0, 0, 0])]
+    )
 
 
 def test_lag_delays_by_whole_samples_and_bias_adds():
@@ -55,7 +65,9 @@ def test_force_is_rotated_into_world():
     R_WS = RotationMatrix.MakeXRotation(np.pi)  # tool pointing down
     _fix(system, context, np.array([0.0, 0.0, 4.0]), R_WS)
     context.SetDiscreteState(system.EvalUniquePeriodicDiscreteUpdate(context))
-    np.testing.assert_allclose(system.get_force_output_port().Eval(context), [0, 0, -4.0], atol=1e-12)
+    np.testing.assert_allclose(
+        system.get_force_output_port().Eval(context), [0, 0, -4.0], atol=1e-12
+    )
 
 
 def test_noise_scales_the_noise_input():
@@ -64,7 +76,9 @@ def test_noise_scales_the_noise_input():
     _fix(system, context, np.zeros(3))
     system.get_noise_input_port().FixValue(context, np.ones(6))
     context.SetDiscreteState(system.EvalUniquePeriodicDiscreteUpdate(context))
-    np.testing.assert_allclose(system.get_wrench_output_port().Eval(context), [0, 0, 0, 0.1, 0.2, 0.3])
+    np.testing.assert_allclose(
+        system.get_wrench_output_port().Eval(context), [0, 0, 0, 0.1, 0.2, 0.3]
+    )
 
 
 def test_bad_settings_are_rejected():

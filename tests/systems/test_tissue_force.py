@@ -16,8 +16,12 @@ def _plane_phantom(z0=0.1, gx=0.2, gy=-0.1, kappa=3000.0, lam=30000.0):
     ys = np.linspace(-0.2, 0.2, 41)
     X, Y = np.meshgrid(xs, ys, indexing="ij")
     return GridPhantom(
-        x_m=xs, y_m=ys, z_m=z0 + gx * X + gy * Y,
-        kappa=np.full(X.shape, kappa), lam=np.full(X.shape, lam), beta=1.35,
+        x_m=xs,
+        y_m=ys,
+        z_m=z0 + gx * X + gy * Y,
+        kappa=np.full(X.shape, kappa),
+        lam=np.full(X.shape, lam),
+        beta=1.35,
     )
 
 
@@ -62,7 +66,9 @@ def test_system_applies_force_at_tip_and_reaction_on_phantom():
         ph, indenter_body_index=BodyIndex(1), p_BT=p_BT, phantom_body_index=BodyIndex(2)
     )
     context = system.CreateDefaultContext()
-    X_WB = RigidTransform(RotationMatrix.MakeXRotation(np.pi), [0.01, 0.02, 0.09 + 0.07])
+    X_WB = RigidTransform(
+        RotationMatrix.MakeXRotation(np.pi), [0.01, 0.02, 0.09 + 0.07]
+    )
     # Tool pointing down: tip at z = 0.09, 1 cm deep.
     poses = [RigidTransform(), X_WB, RigidTransform([0, 0, 0.0])]
     vels = [SpatialVelocity.Zero()] * 3
@@ -71,7 +77,9 @@ def test_system_applies_force_at_tip_and_reaction_on_phantom():
     forces = system.get_spatial_forces_output_port().Eval(context)
     expected = float(hunt_crossley_force(0.01, 0.0, 3000.0, 30000.0, 1.35))
     assert system.get_penetration_output_port().Eval(context)[0] == pytest.approx(0.01)
-    np.testing.assert_allclose(system.get_force_output_port().Eval(context), [0, 0, expected])
+    np.testing.assert_allclose(
+        system.get_force_output_port().Eval(context), [0, 0, expected]
+    )
     on_tip, on_phantom = forces
     assert int(on_tip.body_index) == 1 and int(on_phantom.body_index) == 2
     np.testing.assert_allclose(on_tip.p_BoBq_B, p_BT)
@@ -87,21 +95,27 @@ def test_grid_lookup_equals_the_grid_phantom():
     X, Y = np.meshgrid(xs, ys, indexing="ij")
     for lookup in ("bilinear", "nearest"):
         ph = GridPhantom(
-            x_m=xs, y_m=ys, z_m=0.1 + 0.02 * np.sin(40 * X) * np.cos(30 * Y),
-            kappa=3000 + 500 * np.cos(50 * X), lam=2e4 + 1e3 * np.sin(20 * Y),
+            x_m=xs,
+            y_m=ys,
+            z_m=0.1 + 0.02 * np.sin(40 * X) * np.cos(30 * Y),
+            kappa=3000 + 500 * np.cos(50 * X),
+            lam=2e4 + 1e3 * np.sin(20 * Y),
             lookup=lookup,
         )
         fast = GridLookup(ph)
         # Inside, on nodes, and outside the grid (clamped, zero gradient across).
-        pts = np.concatenate([
-            rng.uniform([-0.12, -0.42], [0.07, -0.28], (200, 2)),
-            np.stack(np.meshgrid(xs[::7], ys[::5]), -1).reshape(-1, 2),
-        ])
+        pts = np.concatenate(
+            [
+                rng.uniform([-0.12, -0.42], [0.07, -0.28], (200, 2)),
+                np.stack(np.meshgrid(xs[::7], ys[::5]), -1).reshape(-1, 2),
+            ]
+        )
         for x, y in pts:
             a, b = ph.sample(x, y), fast.sample(x, y)
             for name in ("surface_z_m", "dz_dx", "dz_dy", "kappa", "lam"):
-                assert getattr(b, name) == pytest.approx(float(getattr(a, name)), rel=1e-12,
-                                                         abs=1e-12), (lookup, name, x, y)
+                assert getattr(b, name) == pytest.approx(
+                    float(getattr(a, name)), rel=1e-12, abs=1e-12
+                ), (lookup, name, x, y)
 
 
 def test_grid_lookup_of_the_synthetic_chest_is_close():
@@ -123,7 +137,9 @@ def test_optional_friction_opposes_sliding_and_scales_with_the_normal_force():
     v = np.array([-0.01, 0.0, 0.0])  # sliding along -x at 1 cm/s
     none = tip_contact(ph, [0, 0, 0.09], v)
     assert none.friction_x_N == 0.0 and none.friction_y_N == 0.0
-    c = tip_contact(ph, [0, 0, 0.09], v, friction_coefficient=0.3, slip_speed_m_per_s=1e-4)
+    c = tip_contact(
+        ph, [0, 0, 0.09], v, friction_coefficient=0.3, slip_speed_m_per_s=1e-4
+    )
     assert c.friction_x_N == pytest.approx(0.3 * c.force_N, rel=1e-3)
     assert c.friction_y_N == 0.0
     off = tip_contact(ph, [0, 0, 0.11], v, friction_coefficient=0.3)
@@ -135,5 +151,7 @@ def test_optional_force_along_the_surface_normal():
     vertical = tip_contact(ph, [0.0, 0.0, 0.09], np.zeros(3))
     normal = tip_contact(ph, [0.0, 0.0, 0.09], np.zeros(3), along_normal=True)
     assert normal.force_N == vertical.force_N > 0
-    np.testing.assert_allclose(normal.force_W, vertical.force_N * np.array([-0.2, 0.1, 1.0]))
+    np.testing.assert_allclose(
+        normal.force_W, vertical.force_N * np.array([-0.2, 0.1, 1.0])
+    )
     np.testing.assert_allclose(vertical.force_W, [0.0, 0.0, vertical.force_N])

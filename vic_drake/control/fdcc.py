@@ -55,7 +55,9 @@ def _check_vec(name, value, n, *, nonneg=False):
     a = np.asarray(value, float)
     if a.shape != (n,) or not np.all(np.isfinite(a)) or (nonneg and np.any(a < 0)):
         what = "non-negative " if nonneg else ""
-        raise VicDrakeError(f"FdccParams.{name} must be {n} finite {what}numbers, got {value!r}")
+        raise VicDrakeError(
+            f"FdccParams.{name} must be {n} finite {what}numbers, got {value!r}"
+        )
 
 
 @dataclass
@@ -75,11 +77,15 @@ class FdccParams:
     d_gains: tuple[float, ...] = (0.005, 0.005, 0.01, 0.0, 0.0, 0.0)
     # Rotational stiffness about x, y, z of W, N m/rad.
     rotational_stiffness_Nm_per_rad: tuple[float, float, float] = (50.0, 50.0, 50.0)
-    link_mass_kg: float = 0.1  # Mass of each moving link of the model, kg (FZI default).
+    link_mass_kg: float = (
+        0.1  # Mass of each moving link of the model, kg (FZI default).
+    )
     link_inertia_kg_m2: float = 1e-6  # Their rotational inertia, kg m^2.
     end_effector_mass_kg: float = 1.0  # Model mass at the probe frame, kg.
     end_effector_inertia_kg_m2: float = 1.0  # Its rotational inertia, kg m^2.
-    velocity_decay: float = 0.9  # Internal velocity factor per step (FZI: 10 % damping).
+    velocity_decay: float = (
+        0.9  # Internal velocity factor per step (FZI: 10 % damping).
+    )
     # Target orientation of the probe frame, quaternion (w, x, y, z): pointing down.
     target_orientation_wxyz: tuple[float, float, float, float] = (0.0, 1.0, 0.0, 0.0)
     # Pose in the Cartesian error: "command" (FZI: the model's pose after the
@@ -88,15 +94,27 @@ class FdccParams:
     pose_feedback: str = "command"
 
     def __post_init__(self):
-        for name in ("period_s", "internal_period_s", "error_scale", "link_mass_kg",
-                     "link_inertia_kg_m2", "end_effector_mass_kg",
-                     "end_effector_inertia_kg_m2"):
+        for name in (
+            "period_s",
+            "internal_period_s",
+            "error_scale",
+            "link_mass_kg",
+            "link_inertia_kg_m2",
+            "end_effector_mass_kg",
+            "end_effector_inertia_kg_m2",
+        ):
             value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and np.isfinite(value) and value > 0):
-                raise VicDrakeError(f"FdccParams.{name} must be a number > 0, got {value!r}")
+            if not (
+                isinstance(value, (int, float)) and np.isfinite(value) and value > 0
+            ):
+                raise VicDrakeError(
+                    f"FdccParams.{name} must be a number > 0, got {value!r}"
+                )
         it = self.iterations
         if isinstance(it, bool) or not isinstance(it, (int, np.integer)) or it < 1:
-            raise VicDrakeError(f"FdccParams.iterations must be an integer >= 1, got {it!r}")
+            raise VicDrakeError(
+                f"FdccParams.iterations must be an integer >= 1, got {it!r}"
+            )
         if not (0 < self.velocity_decay <= 1):
             raise VicDrakeError(
                 f"FdccParams.velocity_decay must be in (0, 1], got {self.velocity_decay!r}"
@@ -108,8 +126,12 @@ class FdccParams:
             )
         _check_vec("p_gains", self.p_gains, 6, nonneg=True)
         _check_vec("d_gains", self.d_gains, 6, nonneg=True)
-        _check_vec("rotational_stiffness_Nm_per_rad", self.rotational_stiffness_Nm_per_rad, 3,
-                   nonneg=True)
+        _check_vec(
+            "rotational_stiffness_Nm_per_rad",
+            self.rotational_stiffness_Nm_per_rad,
+            3,
+            nonneg=True,
+        )
         _check_vec("target_orientation_wxyz", self.target_orientation_wxyz, 4)
         if not np.linalg.norm(self.target_orientation_wxyz) > 0.5:
             raise VicDrakeError(
@@ -138,23 +160,32 @@ class FdccModel:
         ur3e = AddUr3e(plant)
         X_3P = station_params.X_W3M @ RigidTransform(station_params.p_MP)
         ee = plant.AddRigidBody(
-            "fdcc_end_effector", ur3e,
+            "fdcc_end_effector",
+            ur3e,
             SpatialInertia(
-                params.end_effector_mass_kg, np.zeros(3),
+                params.end_effector_mass_kg,
+                np.zeros(3),
                 UnitInertia.TriaxiallySymmetric(
                     params.end_effector_inertia_kg_m2 / params.end_effector_mass_kg
                 ),
             ),
         )
-        plant.WeldFrames(plant.GetFrameByName("wrist_3_link", ur3e), ee.body_frame(), X_3P)
+        plant.WeldFrames(
+            plant.GetFrameByName("wrist_3_link", ur3e), ee.body_frame(), X_3P
+        )
         plant.Finalize()
         context = plant.CreateDefaultContext()
         light = SpatialInertia(
-            params.link_mass_kg, np.zeros(3),
-            UnitInertia.TriaxiallySymmetric(params.link_inertia_kg_m2 / params.link_mass_kg),
+            params.link_mass_kg,
+            np.zeros(3),
+            UnitInertia.TriaxiallySymmetric(
+                params.link_inertia_kg_m2 / params.link_mass_kg
+            ),
         )
         for name in UR3E_JOINTS:
-            plant.GetJointByName(name, ur3e).child_body().SetSpatialInertiaInBodyFrame(context, light)
+            plant.GetJointByName(name, ur3e).child_body().SetSpatialInertiaInBodyFrame(
+                context, light
+            )
         self.plant = plant
         self.ur3e = ur3e
         self.frame = ee.body_frame()
@@ -176,8 +207,12 @@ class FdccModel:
         self.set_positions(q)
         H = self.plant.CalcMassMatrix(self._context)
         J = self.plant.CalcJacobianSpatialVelocity(
-            self._context, JacobianWrtVariable.kV, self.frame, np.zeros(3),
-            self.plant.world_frame(), self.plant.world_frame(),
+            self._context,
+            JacobianWrtVariable.kV,
+            self.frame,
+            np.zeros(3),
+            self.plant.world_frame(),
+            self.plant.world_frame(),
         )
         return self.frame.CalcPoseInWorld(self._context), H, J
 
@@ -201,7 +236,13 @@ class FdccStep:
 
 
 def net_cartesian_error(
-    X_WP, p_WP_target, R_WP_target, stiffness, rotational_stiffness, measured_force, target_force
+    X_WP,
+    p_WP_target,
+    R_WP_target,
+    stiffness,
+    rotational_stiffness,
+    measured_force,
+    target_force,
 ) -> np.ndarray:
     """FDCC's net error ``[K e_p + (f_t - f_m); K_rot e_R]`` in W (trans, rot).
 
@@ -250,7 +291,15 @@ def fdcc_step(
         R_WP_target: the orientation target; default ``params.R_WP_target``
             (pass it to save rebuilding it every tick).
     """
-    inputs = (q_measured, qdot, last_error, p_WP_target, stiffness, measured_force, target_force)
+    inputs = (
+        q_measured,
+        qdot,
+        last_error,
+        p_WP_target,
+        stiffness,
+        measured_force,
+        target_force,
+    )
     arrays = [np.asarray(a, float) for a in inputs]
     q_prev = np.asarray(q_command_prev, float)
     hold = FdccStep(q_prev.copy(), np.zeros(6), np.zeros(6), False)

@@ -133,11 +133,16 @@ def boundary_triangles(vertices: np.ndarray, tets: np.ndarray) -> np.ndarray:
     a, b, c = (vertices[faces[:, i]] for i in range(3))
     normal = np.cross(b - a, c - a)
     inward = np.einsum("ij,ij->i", normal, vertices[opposite] - a) > 0
-    faces[inward, 1], faces[inward, 2] = faces[inward, 2].copy(), faces[inward, 1].copy()
+    faces[inward, 1], faces[inward, 2] = (
+        faces[inward, 2].copy(),
+        faces[inward, 1].copy(),
+    )
     return faces
 
 
-def write_obj(path: str | os.PathLike, vertices: np.ndarray, triangles: np.ndarray) -> Path:
+def write_obj(
+    path: str | os.PathLike, vertices: np.ndarray, triangles: np.ndarray
+) -> Path:
     """Writes a triangle surface as Wavefront OBJ (for visualization)."""
     path = Path(path)
     used = np.unique(triangles)

@@ -39,8 +39,9 @@ class FdccController(LeafSystem):
     internal velocity (6) and the PD's last error (6), and the status (2).
     """
 
-    def __init__(self, params: FdccParams | None = None, *, station_params=None,
-                 initial_q=None):
+    def __init__(
+        self, params: FdccParams | None = None, *, station_params=None, initial_q=None
+    ):
         """
         Args:
             params: the FDCC settings (default FdccParams()).
@@ -51,12 +52,16 @@ class FdccController(LeafSystem):
         super().__init__()
         self._params = params or FdccParams()
         if not isinstance(self._params, FdccParams):
-            raise VicDrakeError(f"params must be FdccParams, got {type(params).__name__}")
+            raise VicDrakeError(
+                f"params must be FdccParams, got {type(params).__name__}"
+            )
         self._model = FdccModel(self._params, station_params)
         self._R_WP_target = self._params.R_WP_target
         q0 = np.zeros(6) if initial_q is None else np.asarray(initial_q, float)
         if q0.shape != (6,) or not np.all(np.isfinite(q0)):
-            raise VicDrakeError(f"initial_q must be 6 finite joint angles (rad), got {initial_q!r}")
+            raise VicDrakeError(
+                f"initial_q must be 6 finite joint angles (rad), got {initial_q!r}"
+            )
         self._q_port = self.DeclareVectorInputPort("joint_positions", 6)
         self._target_port = self.DeclareVectorInputPort("target_position", 3)
         self._stiffness_port = self.DeclareVectorInputPort("stiffness", 3)
@@ -65,8 +70,12 @@ class FdccController(LeafSystem):
         self._q_cmd = self.DeclareDiscreteState(q0)
         self._internal = self.DeclareDiscreteState(12)
         self._status = self.DeclareDiscreteState(2)
-        self.DeclarePeriodicDiscreteUpdateEvent(self._params.period_s, 0.0, self._update)
-        self._command_port = self.DeclareStateOutputPort("position_command", self._q_cmd)
+        self.DeclarePeriodicDiscreteUpdateEvent(
+            self._params.period_s, 0.0, self._update
+        )
+        self._command_port = self.DeclareStateOutputPort(
+            "position_command", self._q_cmd
+        )
         self._status_port = self.DeclareStateOutputPort("status", self._status)
 
     @property
@@ -121,7 +130,10 @@ class FdccController(LeafSystem):
         )
         status = context.get_discrete_state(self._status).get_value()
         discrete_state.set_value(self._q_cmd, step.q_command)
-        discrete_state.set_value(self._internal, np.concatenate([step.qdot, step.last_error]))
         discrete_state.set_value(
-            self._status, [0.0 if step.ok else 1.0, status[1] + (0.0 if step.ok else 1.0)]
+            self._internal, np.concatenate([step.qdot, step.last_error])
+        )
+        discrete_state.set_value(
+            self._status,
+            [0.0 if step.ok else 1.0, status[1] + (0.0 if step.ok else 1.0)],
         )

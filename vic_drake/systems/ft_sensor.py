@@ -55,11 +55,13 @@ def tared_sensor_wrench(
     g_S = np.asarray(R_WS, float).T @ np.asarray(gravity_W, float)
     f_static = -distal_mass_kg * g_S  # the sensor holds the weight up
     p = np.asarray(p_SScm, float)
-    tau_static = np.array([  # p x f_static (np.cross is slow on 3-vectors)
-        p[1] * f_static[2] - p[2] * f_static[1],
-        p[2] * f_static[0] - p[0] * f_static[2],
-        p[0] * f_static[1] - p[1] * f_static[0],
-    ])
+    tau_static = np.array(
+        [  # p x f_static (np.cross is slow on 3-vectors)
+            p[1] * f_static[2] - p[2] * f_static[1],
+            p[2] * f_static[0] - p[0] * f_static[2],
+            p[0] * f_static[1] - p[1] * f_static[0],
+        ]
+    )
     return F_S - np.concatenate([tau_static, f_static])
 
 
@@ -110,7 +112,9 @@ class ForceTorqueSensor(LeafSystem):
         if not (np.isfinite(period_s) and period_s > 0):
             raise VicDrakeError(f"period_s must be > 0, got {period_s!r}")
         if int(lag_samples) != lag_samples or lag_samples < 0:
-            raise VicDrakeError(f"lag_samples must be an integer >= 0, got {lag_samples!r}")
+            raise VicDrakeError(
+                f"lag_samples must be an integer >= 0, got {lag_samples!r}"
+            )
         self._joint = int(weld_joint_index)
         self._child = int(child_body_index)
         self._R_CS = X_CS.rotation().matrix()
@@ -130,11 +134,15 @@ class ForceTorqueSensor(LeafSystem):
         self._buffer = self.DeclareDiscreteState(6 * self._n)
         self.DeclarePeriodicDiscreteUpdateEvent(period_s, 0.0, self._update)
         self._wrench_port = self.DeclareVectorOutputPort(
-            "wrench_S", 6, self._calc_wrench,
+            "wrench_S",
+            6,
+            self._calc_wrench,
             prerequisites_of_calc={self.xd_ticket()},
         )
         self._force_port = self.DeclareVectorOutputPort(
-            "force_W", 3, self._calc_force,
+            "force_W",
+            3,
+            self._calc_force,
             prerequisites_of_calc={self.xd_ticket(), self._poses_port.ticket()},
         )
 

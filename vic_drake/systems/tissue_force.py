@@ -85,9 +85,13 @@ class TipContact:
     @property
     def force_W(self) -> np.ndarray:
         """The whole force on the tip in W, N: tilt + friction in x, y; HC in z."""
-        return np.array([
-            self.tilt_x_N + self.friction_x_N, self.tilt_y_N + self.friction_y_N, self.force_N
-        ])
+        return np.array(
+            [
+                self.tilt_x_N + self.friction_x_N,
+                self.tilt_y_N + self.friction_y_N,
+                self.force_N,
+            ]
+        )
 
 
 @dataclass(frozen=True)
@@ -125,8 +129,13 @@ class GridLookup:
         self.name = getattr(phantom, "name", "phantom")
         if isinstance(phantom, GridPhantom):
             xs, ys = phantom.x_m, phantom.y_m
-            grids = (phantom.surface_m, phantom.dz_dx_grid, phantom.dz_dy_grid,
-                     phantom.kappa_grid, phantom.lam_grid)
+            grids = (
+                phantom.surface_m,
+                phantom.dz_dx_grid,
+                phantom.dz_dy_grid,
+                phantom.kappa_grid,
+                phantom.lam_grid,
+            )
             self.nearest = phantom.lookup == "nearest"
         else:
             xs, ys, smp = phantom.rasterize(resolution_m)
@@ -153,12 +162,16 @@ class GridLookup:
             values = [g[i][j] for g in self._grids]
         else:
             values = [
-                (1 - wx) * (1 - wy) * g[i][j] + wx * (1 - wy) * g[i + 1][j]
-                + (1 - wx) * wy * g[i][j + 1] + wx * wy * g[i + 1][j + 1]
+                (1 - wx) * (1 - wy) * g[i][j]
+                + wx * (1 - wy) * g[i + 1][j]
+                + (1 - wx) * wy * g[i][j + 1]
+                + wx * wy * g[i + 1][j + 1]
                 for g in self._grids
             ]
         surface, gx, gy, kappa, lam = values
-        return TissueSample(surface, gx if in_x else 0.0, gy if in_y else 0.0, kappa, lam)
+        return TissueSample(
+            surface, gx if in_x else 0.0, gy if in_y else 0.0, kappa, lam
+        )
 
 
 def tip_contact(
@@ -206,28 +219,45 @@ def tip_contact(
     force = 0.0  # out of contact (the law's value too; skips its numpy cost)
     if eps > 0.0:
         force = float(
-            hunt_crossley_force(eps, eps_dot, s.kappa, s.lam, phantom.beta, clip_tension=True)
+            hunt_crossley_force(
+                eps, eps_dot, s.kappa, s.lam, phantom.beta, clip_tension=True
+            )
         )
     fx = fy = 0.0
     if friction_coefficient > 0.0 and force > 0.0:
         vx, vy = float(v_rel[0]), float(v_rel[1])
-        scale = -friction_coefficient * force / np.sqrt(vx * vx + vy * vy + slip_speed_m_per_s**2)
+        scale = (
+            -friction_coefficient
+            * force
+            / np.sqrt(vx * vx + vy * vy + slip_speed_m_per_s**2)
+        )
         fx, fy = scale * vx, scale * vy
     tx = ty = 0.0
     if along_normal and force > 0.0:
         tx, ty = -float(s.dz_dx) * force, -float(s.dz_dy) * force
     return TipContact(
-        force, float(eps), float(eps_dot), surface, float(s.kappa), float(s.lam), fx, fy, tx, ty
+        force,
+        float(eps),
+        float(eps_dot),
+        surface,
+        float(s.kappa),
+        float(s.lam),
+        fx,
+        fy,
+        tx,
+        ty,
     )
 
 
 def _cross(a, b) -> np.ndarray:
     """a x b for 3-vectors (np.cross costs ~50 us per call; this runs each step)."""
-    return np.array([
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ])
+    return np.array(
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    )
 
 
 class TissueForceElement(LeafSystem):
@@ -280,7 +310,9 @@ class TissueForceElement(LeafSystem):
                 f"friction_coefficient must be >= 0, got {friction_coefficient!r}"
             )
         if not (np.isfinite(slip_speed_m_per_s) and slip_speed_m_per_s > 0):
-            raise VicDrakeError(f"slip_speed_m_per_s must be > 0, got {slip_speed_m_per_s!r}")
+            raise VicDrakeError(
+                f"slip_speed_m_per_s must be > 0, got {slip_speed_m_per_s!r}"
+            )
         self._mu = float(friction_coefficient)
         self._along_normal = bool(along_normal)
         self._slip = float(slip_speed_m_per_s)
@@ -300,7 +332,9 @@ class TissueForceElement(LeafSystem):
         )
         self._contact_cache = self.DeclareCacheEntry(
             description="tip_contact",
-            value_producer=ValueProducer(allocate=model_value.Clone, calc=self._calc_contact),
+            value_producer=ValueProducer(
+                allocate=model_value.Clone, calc=self._calc_contact
+            ),
             prerequisites_of_calc={self.all_input_ports_ticket()},
         )
         self._forces_port = self.DeclareAbstractOutputPort(
@@ -310,16 +344,20 @@ class TissueForceElement(LeafSystem):
             prerequisites_of_calc={self._contact_cache.ticket()},
         )
         self._force_port = self.DeclareVectorOutputPort(
-            "force_W", 3, self._calc_force,
+            "force_W",
+            3,
+            self._calc_force,
             prerequisites_of_calc={self._contact_cache.ticket()},
         )
         self._penetration_port = self.DeclareVectorOutputPort(
-            "penetration", 1,
+            "penetration",
+            1,
             lambda c, out: out.SetAtIndex(0, self._contact(c).penetration_m),
             prerequisites_of_calc={self._contact_cache.ticket()},
         )
         self._surface_port = self.DeclareVectorOutputPort(
-            "surface_z", 1,
+            "surface_z",
+            1,
             lambda c, out: out.SetAtIndex(0, self._contact(c).surface_z_m),
             prerequisites_of_calc={self._contact_cache.ticket()},
         )
@@ -360,8 +398,13 @@ class TissueForceElement(LeafSystem):
         p_WPh = poses[int(self._phantom_body)].translation()
         V_WPh = velocities[int(self._phantom_body)]
         contact = tip_contact(
-            self._phantom, p_WT, v_WT, p_WPh, V_WPh.translational(),
-            friction_coefficient=self._mu, slip_speed_m_per_s=self._slip,
+            self._phantom,
+            p_WT,
+            v_WT,
+            p_WPh,
+            V_WPh.translational(),
+            friction_coefficient=self._mu,
+            slip_speed_m_per_s=self._slip,
             along_normal=self._along_normal,
         )
         value.set_value(_Cached(contact, p_WT, p_WPh))
