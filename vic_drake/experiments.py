@@ -27,7 +27,7 @@ from __future__ import annotations
 import copy
 import re
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -258,6 +258,9 @@ class ScanResult:
         sim_s: simulated time, s.
         rtf: real-time factor, sim_s / wall_s (> 1: faster than real time).
         build_s: wall-clock time spent building the diagram, s.
+        cpu_s: CPU time of this process during the simulation, s (on a
+            loaded machine sim_s / cpu_s is the real-time factor the run
+            would have with a core to itself).
     """
 
     df: pd.DataFrame
@@ -266,7 +269,7 @@ class ScanResult:
     sim_s: float
     rtf: float
     build_s: float = 0.0
-    extra: dict = field(default_factory=dict)
+    cpu_s: float = float("nan")
 
 
 def run_scan(
@@ -309,7 +312,7 @@ def run_scan(
     build_s = time.perf_counter() - t_build
     if progress:
         progress(f"{scenario.name}: simulating {duration:.2f} s")
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     chunk = max(1.0, duration / 10)
     t = 0.0
     while t < duration - 1e-12:
@@ -321,6 +324,7 @@ def run_scan(
                 f"{scenario.name}: t = {t:.1f} / {duration:.1f} s ({elapsed:.1f} s wall)"
             )
     wall = time.perf_counter() - t0
+    cpu = time.process_time() - c0
     df = logs_to_frame(loggers, context)
     df.attrs.update(source="sim", scenario=scenario.name)
     return ScanResult(
@@ -330,6 +334,7 @@ def run_scan(
         sim_s=duration,
         rtf=duration / wall if wall > 0 else float("inf"),
         build_s=build_s,
+        cpu_s=cpu,
     )
 
 
@@ -800,6 +805,7 @@ def compare_real(
         else None,
         "rtf": result.rtf,
     }
+    out["rtf_cpu"] = result.sim_s / result.cpu_s if result.cpu_s > 0 else None
     out.update(
         {k: v for k, v in metrics.items() if k not in out},
         log=str(bag),
