@@ -59,7 +59,7 @@ plant step (tissue force) and every 2 ms (sensor, servo filter, FDCC).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 
 import numpy as np
 from airo_models import get_urdf_path
@@ -330,11 +330,6 @@ class StationParams:
     def distal_mass_kg(self) -> float:
         """Mass the sensor carries (wrench side + indenter), kg."""
         return self.ft_wrench_mass_kg + self.indenter_mass_kg
-
-
-def station_params_fields() -> tuple[str, ...]:
-    """Names of the StationParams fields (for scenario schemas and docs)."""
-    return tuple(f.name for f in fields(StationParams))
 
 
 # ----------------------------------------------------------------------------
