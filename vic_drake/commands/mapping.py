@@ -89,6 +89,17 @@ def register(subparsers) -> None:
         "--kernel", default="rbf", help="GP kernel shape: rbf (default) or matern"
     )
     parser.add_argument(
+        "--time-step-ms",
+        type=float,
+        default=1.0,
+        help="indenter plant time step, ms (default 1; 2 halves the simulation time)",
+    )
+    parser.add_argument(
+        "--log-gp",
+        action="store_true",
+        help="model log kappa and log lambda in the GPs (default: the values, as the paper)",
+    )
+    parser.add_argument(
         "--workers",
         type=int,
         default=1,
@@ -159,6 +170,7 @@ def run_map(args) -> int:
         build_tissue_map,
         compare_with_phantom,
     )
+    from vic_drake.systems.indenter import IndenterParams
     from vic_drake.tissue.phantom import PHANTOM_KINDS, load_phantom
 
     start = time.perf_counter()
@@ -171,6 +183,11 @@ def run_map(args) -> int:
         raise VicDrakeError(f"--kernel must be one of {KERNELS}; got {args.kernel!r}")
     resolution_m = _positive(args.resolution_mm, "--resolution-mm") * 1e-3
     spacing_m = _positive(args.spacing_cm, "--spacing-cm") * 1e-2
+    time_step_s = _positive(args.time_step_ms, "--time-step-ms") * 1e-3
+    if time_step_s > 0.002:
+        raise VicDrakeError(
+            f"--time-step-ms must be <= 2 (the sensor's 500 Hz period); got {args.time_step_ms!r}"
+        )
     if args.workers is None or args.workers < 1:
         raise VicDrakeError(f"--workers must be an integer >= 1; got {args.workers!r}")
     out = _prepare_out(args.out)
@@ -199,7 +216,11 @@ def run_map(args) -> int:
     campaign = run_campaign(
         phantom,
         CampaignParams(
-            spacing_m=spacing_m, region_m=region, seed=args.seed, workers=args.workers
+            indenter=IndenterParams(time_step_s=time_step_s),
+            spacing_m=spacing_m,
+            region_m=region,
+            seed=args.seed,
+            workers=args.workers,
         ),
         progress=progress,
     )
@@ -208,7 +229,7 @@ def run_map(args) -> int:
         region,
         beta=campaign.beta,
         resolution_m=resolution_m,
-        gp=GpMapParams(kernel=args.kernel, seed=args.seed),
+        gp=GpMapParams(kernel=args.kernel, seed=args.seed, log_target=args.log_gp),
         progress=progress,
     )
     comparison = compare_with_phantom(tmap, phantom)
@@ -273,16 +294,35 @@ def _figures(tmap, phantom, comparison, out: Path) -> None:
     plot_stiffness_damping_maps(tmap, save_path=out / "fig4_stiffness_damping.png")
     plot_surface_kappa(tmap, save_path=out / "fig5_surface_kappa.png")
     plot_std_maps(tmap, save_path=out / "gp_std.png")
-    X, Y = np.meshgrid(tmap.x_m, tmap.y_m, indexing="ij")
-    truth = phantom.sample(X, Y).kappa
+    truth = _decimated_truth_kappa(tmap, phantom, max_pixels=600)
     plot_map_vs_truth(
-        tmap,
-        truth,
+        truth[0],
+        truth[1],
         ribs_true=comparison.ribs_true,
         ribs_found=comparison.ribs_found,
         y_line_m=comparison.y_line_m,
         save_path=out / "map_vs_truth.png",
     )
+
+
+def _decimated_truth_kappa(tmap, phantom, *, max_pixels: int):
+    """(map decimated to <= max_pixels per axis, the phantom's kappa on its grid)."""
+    from dataclasses import replace
+
+    sx = max(1, int(np.ceil(tmap.x_m.size / max_pixels)))
+    sy = max(1, int(np.ceil(tmap.y_m.size / max_pixels)))
+    small = replace(
+        tmap,
+        x_m=tmap.x_m[::sx],
+        y_m=tmap.y_m[::sy],
+        surface_z_m=tmap.surface_z_m[::sx, ::sy],
+        kappa=tmap.kappa[::sx, ::sy],
+        lam=tmap.lam[::sx, ::sy],
+        kappa_std=tmap.kappa_std[::sx, ::sy],
+        lam_std=tmap.lam_std[::sx, ::sy],
+    )
+    X, Y = np.meshgrid(small.x_m, small.y_m, indexing="ij")
+    return small, phantom.sample(X, Y).kappa
 
 
 __all__ = ["METRIC_KEYS", "default_region", "register", "run_map"]

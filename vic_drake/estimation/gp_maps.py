@@ -57,7 +57,15 @@ class GpMapParams:
             identifiable from the samples, and without this bound a few
             points across a rib let the fit collapse to a length scale of
             1 mm (a map that is the mean everywhere between the points).
-        n_restarts: optimiser restarts from random hyperparameters.
+        n_restarts: optimiser restarts from random hyperparameters (the
+            marginal likelihood of lambda on the synthetic chest has local
+            optima: 3 restarts gave a 22 % map error, 8 gave 19 %).
+        log_target: model log(value) instead of the value (the paper models
+            the value). The map is then exp(mean) (the log-normal median)
+            and its std exp(mean) * std_log (first order). Positive by
+            construction; on the synthetic chest (sharp ribs) it cut the
+            lambda map error from 19 % to 6 %, on the measured map (itself
+            a GP in linear space) it raised it from 5.7 % to 7.5 %.
         chunk_size: grid points predicted per chunk.
         seed: seed of the restarts.
     """
@@ -68,7 +76,8 @@ class GpMapParams:
     length_scale_bounds_m: tuple[float, float] = (1e-3, 0.5)
     noise_level_bounds: tuple[float, float] = (1e-6, 1.0)
     min_length_scale_spacing: float = 0.5
-    n_restarts: int = 3
+    n_restarts: int = 8
+    log_target: bool = False
     chunk_size: int = 50_000
     seed: int = 0
 
@@ -310,6 +319,22 @@ def length_scales(gp: GaussianProcessRegressor) -> tuple[float, float]:
     return float(ls[0]), float(ls[1])
 
 
+def _to_target(values, params: GpMapParams) -> np.ndarray:
+    values = np.asarray(values, float)
+    if not params.log_target:
+        return values
+    if np.any(~(values > 0)):
+        raise VicDrakeError("log_target needs positive values (a fit gave <= 0)")
+    return np.log(values)
+
+
+def _from_target(mean, std, params: GpMapParams):
+    if not params.log_target:
+        return mean, std
+    value = np.exp(mean)
+    return value, value * std
+
+
 def gp_map(
     x, y, values, xs, ys, params: GpMapParams | None = None, *, std_step: int = 1
 ) -> GpMap:
@@ -319,10 +344,11 @@ def gp_map(
     """
     params = params or GpMapParams()
     t0 = time.perf_counter()
-    gp = fit_gp(x, y, values, params)
+    gp = fit_gp(x, y, _to_target(values, params), params)
     t1 = time.perf_counter()
-    mean, std = predict_grid(
-        gp, xs, ys, chunk_size=params.chunk_size, std_step=std_step
+    mean, std = _from_target(
+        *predict_grid(gp, xs, ys, chunk_size=params.chunk_size, std_step=std_step),
+        params,
     )
     t2 = time.perf_counter()
     return GpMap(
@@ -478,9 +504,11 @@ def build_tissue_map(
         ("lam", "lambda_N_s_per_m_beta1"),
     ):
         t0 = time.perf_counter()
-        model = fit_gp(px, py, ok[column].to_numpy(float), gp)
+        model = fit_gp(px, py, _to_target(ok[column].to_numpy(float), gp), gp)
         t1 = time.perf_counter()
-        mean, std = predict_grid(model, xs, ys, chunk_size=gp.chunk_size, std_step=step)
+        mean, std = _from_target(
+            *predict_grid(model, xs, ys, chunk_size=gp.chunk_size, std_step=step), gp
+        )
         t2 = time.perf_counter()
         maps[key] = (mean, std, str(model.kernel_))
         timings[f"{key}_gp_fit"] = t1 - t0
@@ -570,6 +598,7 @@ def compare_with_phantom(
     y_line_m: float | None = None,
     band_m: float = 0.01,
     edge_m: float = 0.01,
+    chunk_size: int = 200_000,
 ) -> MapComparison:
     """Errors of a map against the phantom it was palpated on.
 
@@ -579,21 +608,27 @@ def compare_with_phantom(
     ``y_line_m``; otherwise (the measured map) the peaks that
     :func:`find_ribs` finds on the phantom's own kappa on the same grid and
     band. Ribs within ``edge_m`` of the map's x edges are left out of both
-    lists (a peak at the edge cannot be located).
+    lists (a peak at the edge cannot be located). The truth is sampled in
+    blocks of about ``chunk_size`` grid points.
     """
     xs, ys = tmap.x_m, tmap.y_m
-    X, Y = np.meshgrid(xs, ys, indexing="ij")
-    truth = phantom.sample(X, Y)
-    del X, Y
-
-    def rel_rms(est, true):
-        return float(100.0 * np.sqrt(np.mean(((est - true) / true) ** 2)))
-
-    kappa_pct = rel_rms(tmap.kappa, truth.kappa)
-    lam_pct = rel_rms(tmap.lam, truth.lam)
-    surface_mm = float(
-        1e3 * np.sqrt(np.mean((tmap.surface_z_m - truth.surface_z_m) ** 2))
-    )
+    # Sums of squared errors, accumulated over blocks of x-rows so the truth
+    # of a 2 M-point map is never held whole.
+    sums = np.zeros(3)
+    rows = max(1, chunk_size // ys.size)
+    for i0 in range(0, xs.size, rows):
+        i1 = min(xs.size, i0 + rows)
+        X, Y = np.meshgrid(xs[i0:i1], ys, indexing="ij")
+        truth = phantom.sample(X, Y)
+        sums += (
+            np.sum(((tmap.kappa[i0:i1] - truth.kappa) / truth.kappa) ** 2),
+            np.sum(((tmap.lam[i0:i1] - truth.lam) / truth.lam) ** 2),
+            np.sum((tmap.surface_z_m[i0:i1] - truth.surface_z_m) ** 2),
+        )
+    n = xs.size * ys.size
+    kappa_pct = float(100.0 * np.sqrt(sums[0] / n))
+    lam_pct = float(100.0 * np.sqrt(sums[1] / n))
+    surface_mm = float(1e3 * np.sqrt(sums[2] / n))
     y_line = float(np.mean([ys[0], ys[-1]])) if y_line_m is None else float(y_line_m)
     lo, hi = xs[0] + edge_m, xs[-1] - edge_m
 
@@ -604,7 +639,12 @@ def compare_with_phantom(
     if hasattr(phantom, "rib_centres_x"):
         true = inside(np.asarray(phantom.rib_centres_x(y_line)).ravel())
     else:
-        true = inside(find_ribs(xs, band_profile(xs, ys, truth.kappa, y_line, band_m)))
+        band = np.abs(ys - y_line) <= band_m + 1e-12
+        if not band.any():
+            band = np.abs(ys - y_line) == np.min(np.abs(ys - y_line))
+        X, Y = np.meshgrid(xs, ys[band], indexing="ij")
+        true_kappa = phantom.sample(X, Y).kappa
+        true = inside(find_ribs(xs, true_kappa.mean(axis=1)))
     errors = tuple(
         float(np.min(np.abs(np.asarray(found) - t))) if found else float("nan")
         for t in true
