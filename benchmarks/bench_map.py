@@ -1,7 +1,7 @@
 """Timing of the whole map pipeline (prints figures; no asserts).
 
     /work/venv/bin/python benchmarks/bench_map.py [--data-dir DIR] [--phantom measured]
-        [--resolution-mm 0.1] [--workers 1] [--designs]
+        [--resolution-mm 0.1] [--workers 1] [--time-step-ms 1] [--designs]
 
 Runs what ``vic-drake map`` runs on the measured map's region (21 x 11 = 231
 palpation points at 1 cm; the synthetic phantom on the same region when the
@@ -94,6 +94,7 @@ def main(argv=None) -> int:
     )
     parser.add_argument("--resolution-mm", type=float, default=0.1)
     parser.add_argument("--workers", type=int, default=1)
+    parser.add_argument("--time-step-ms", type=float, default=1.0)
     parser.add_argument("--designs", action="store_true")
     parser.add_argument("--no-figures", action="store_true")
     args = parser.parse_args(argv)
@@ -123,8 +124,12 @@ def main(argv=None) -> int:
         designs(phantom, 40)
 
     wall0 = time.perf_counter()
+    from vic_drake.systems.indenter import IndenterParams
+
+    indenter = IndenterParams(time_step_s=args.time_step_ms * 1e-3)
     campaign = run_campaign(
-        phantom, CampaignParams(region_m=region, workers=args.workers)
+        phantom,
+        CampaignParams(region_m=region, workers=args.workers, indenter=indenter),
     )
     print(f"campaign: {len(campaign.points)} points")
     print(f"  simulate (indenter bank)      {campaign.simulate_s:7.2f} s")

@@ -166,3 +166,14 @@ def test_build_tissue_map_from_synthetic_points():
     assert max(c.rib_errors_m) < 2e-3
     with pytest.raises(VicDrakeError, match="at least 4"):
         build_tissue_map(points.iloc[:3], region, beta=1.35)
+
+
+def test_log_target_map_is_positive_and_accurate(samples):
+    xs, ys = map_axis(0.0, 0.1, 0.005), map_axis(0.0, 0.08, 0.005)
+    m = gp_map(*samples, xs, ys, GpMapParams(log_target=True, n_restarts=1))
+    truth = field(*np.meshgrid(xs, ys, indexing="ij"))
+    assert np.all(m.mean > 0) and np.all(m.std >= 0)
+    assert np.sqrt(np.mean(((m.mean - truth) / truth) ** 2)) < 0.03
+    x, y, v = samples
+    with pytest.raises(VicDrakeError, match="positive"):
+        gp_map(x, y, v - 10_000.0, xs, ys, GpMapParams(log_target=True))
