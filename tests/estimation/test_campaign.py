@@ -134,6 +134,26 @@ def test_campaign_params_reject_bad_values():
         PalpationParams(amplitude_m=0.02)
     with pytest.raises(VicDrakeError, match="lag_samples"):
         SensorParams(lag_samples=-1)
+    with pytest.raises(VicDrakeError, match="common"):
+        simulate_palpations(
+            [0.0, 0.01],
+            [0.0],
+            surface_z=[0.1],
+            kappa=[1.0],
+            lam=[1.0],
+            beta=BETA,
+            params=CampaignParams(),
+        )
+    with pytest.raises(VicDrakeError, match="finite"):
+        simulate_palpations(
+            [0.0],
+            [0.0],
+            surface_z=[np.nan],
+            kappa=[1.0],
+            lam=[1.0],
+            beta=BETA,
+            params=CampaignParams(),
+        )
 
 
 @pytest.mark.parametrize("x", [-0.09, -0.115])  # soft tissue; on a rib

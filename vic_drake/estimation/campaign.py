@@ -209,6 +209,14 @@ def simulate_palpations(
         np.atleast_1d(np.asarray(a, float)) for a in (x, y, surface_z, kappa, lam)
     )
     n = x.size
+    sizes = {a.size for a in (x, y, surface_z, kappa, lam)}
+    if len(sizes) != 1 or n == 0:
+        raise VicDrakeError(
+            "simulate_palpations: x, y, surface_z, kappa, lam must have one common "
+            f"non-zero size; got {[a.size for a in (x, y, surface_z, kappa, lam)]}"
+        )
+    if not np.all(np.isfinite(np.concatenate([surface_z, kappa, lam]))):
+        raise VicDrakeError("simulate_palpations: surface_z, kappa, lam must be finite")
     pal = params.palpation
     bank = MakeIndenterDiagram(
         n, beta=beta, indenter=params.indenter, sensor=params.sensor, palpation=pal
@@ -223,7 +231,8 @@ def simulate_palpations(
         seed=seed,
     )
     simulator = Simulator(bank.diagram, context)
-    # Approach time, then the palpation; stop early once every point is done.
+    # Run the longest allowed approach, then until the last point to touch
+    # has palpated for the full duration.
     simulator.AdvanceTo(pal.max_approach_s)
     contact = bank.contact_logger.FindLog(context).data()[:, -1].reshape(3, n)
     t_c = np.where(contact[0] > 0.5, contact[2], np.nan)
