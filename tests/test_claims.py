@@ -127,6 +127,8 @@ def test_scan_metrics_rmse_range_and_lift_off():
     assert m["lifted_off"] is True
     pressing = C.scan_metrics(_scan(7 + 0 * t, t=t, ref=7.0, lift_at=10.0))
     assert pressing["lifted_off"] is False and pressing["force_rmse_N"] == pytest.approx(0)
+    no_ref = C.scan_metrics(_scan(f, t=t, ref=0.0, lift_at=10.0))
+    assert "force_rmse_N" not in no_ref and no_ref["force_range_N"] > 0
 
 
 def test_scan_metrics_needs_columns():

@@ -21,6 +21,11 @@ def test_options_reject_unknown_stage(tmp_path):
         ReproduceOptions(out_dir=tmp_path, phantom="jelly")
 
 
+def test_options_reject_a_data_dir_without_data(tmp_path):
+    with pytest.raises(VicDrakeError, match="does not hold the paper's data"):
+        ReproduceOptions(out_dir=tmp_path / "out", data_dir=tmp_path)
+
+
 def test_cli_unknown_stage_is_a_clean_error(tmp_path, capsys):
     assert main(["reproduce", "--out", str(tmp_path), "--stages", "bogus"]) == 2
     assert "unknown stage" in capsys.readouterr().err

@@ -492,7 +492,7 @@ def scan_metrics(df: pd.DataFrame, *, limits: ScanLimits = ScanLimits(),
 
     Returns:
         dict with force_rmse_N (pressing force vs reference over the scan
-        window), force_range_N (98th - 2nd percentile of the pressing force in
+        window; only when the reference is nonzero there), force_range_N (98th - 2nd percentile of the pressing force in
         the window), peak_force_N (whole run), lifted_off (mean pressing force
         of the last end_s below the contact threshold), and where the columns
         exist: penetration / force-cap metrics (C6), contact-loss, stiffness
@@ -519,7 +519,10 @@ def scan_metrics(df: pd.DataFrame, *, limits: ScanLimits = ScanLimits(),
         out["force_mean_N"] = float(np.mean(fw))
         if "force_ref_z_N" in df.columns:
             ref = -df["force_ref_z_N"].to_numpy(float)[w]
-            out["force_rmse_N"] = float(np.sqrt(np.mean((fw - ref) ** 2)))
+            # Only a controller with a force reference (CF, VS-CF, VS-VF) has a
+            # tracking error; CS's reference column is zero.
+            if np.any(np.abs(ref) > 0):
+                out["force_rmse_N"] = float(np.sqrt(np.mean((fw - ref) ** 2)))
     # C6: penetration off the ribs, force over the ribs (where the cap binds).
     if {"force_ref_z_N", "force_min_z_N", "penetration_m"} <= set(df.columns) and w.sum():
         ref = -df["force_ref_z_N"].to_numpy(float)

@@ -100,6 +100,18 @@ class ReproduceOptions:
             raise VicDrakeError(
                 f"phantom must be 'auto', 'measured' or 'synthetic', got {self.phantom!r}"
             )
+        if self.data_dir is not None and not has_data(self.data_dir):
+            raise VicDrakeError(
+                f"--data-dir {str(self.data_dir)!r} does not hold the paper's data; expected "
+                "phantom_map/, experiments/, palpation/ and loadcycle/ in it (omit the "
+                "option to run on the synthetic phantom)"
+            )
+        if self.phantom == "measured" and not has_data(self.data_dir):
+            raise VicDrakeError(
+                f"--phantom measured needs the paper's phantom map; none found at "
+                f"{str(resolve_data_dir(self.data_dir))!r} (pass --data-dir DIR or set "
+                "VIC_DRAKE_DATA)"
+            )
         if self.stages is not None:
             unknown = [s for s in self.stages if s not in STAGE_NAMES]
             if unknown:
