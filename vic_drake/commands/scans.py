@@ -88,6 +88,12 @@ def register(subparsers) -> None:
     p.add_argument(
         "--plot", metavar="PNG", default=None, help="save a sim-vs-real figure"
     )
+    p.add_argument(
+        "--out",
+        metavar="FILE",
+        default=None,
+        help="save the simulated log (.parquet or .csv)",
+    )
     add_data_dir_option(p)
     add_json_option(p)
     p.set_defaults(handler=run_compare_real)
@@ -104,6 +110,19 @@ def register(subparsers) -> None:
     add_data_dir_option(s)
     add_json_option(s)
     s.set_defaults(handler=run_scan_command)
+
+
+def _save_log(df, out: str) -> Path:
+    """Writes a scan DataFrame as .parquet or .csv; returns the path."""
+    path = Path(out)
+    if path.suffix not in (".csv", ".parquet"):
+        raise VicDrakeError(f"--out must end in .parquet or .csv; got {str(path)!r}")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if path.suffix == ".csv":
+        df.to_csv(path, index=False)
+    else:
+        df.to_parquet(path, index=False)
+    return path
 
 
 def run_compare_real(args: argparse.Namespace) -> int:
@@ -127,6 +146,8 @@ def run_compare_real(args: argparse.Namespace) -> int:
         progress=progress,
         return_frames=True,
     )
+    if args.out:
+        out["sim_log"] = str(_save_log(sim, args.out))
     if args.plot:
         from vic_drake.plots.scans import plot_comparison
 
@@ -168,16 +189,7 @@ def run_scan_command(args: argparse.Namespace) -> int:
         "lifted_off": metrics.lifted_off(df),
     }
     if args.out:
-        path = Path(args.out)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        if path.suffix == ".csv":
-            df.to_csv(path, index=False)
-        elif path.suffix == ".parquet":
-            df.to_parquet(path, index=False)
-        else:
-            raise VicDrakeError(
-                f"--out must end in .parquet or .csv; got {str(path)!r}"
-            )
+        path = _save_log(df, args.out)
         save_scenario(scenario, path.with_suffix(".scenario.yaml"))
         out["log"] = str(path)
     emit(out, args.json)
