@@ -90,3 +90,32 @@ def test_out_that_is_a_file_exits_2(tmp_path, capsys):
     path.write_text("x")
     assert main(["map", "--out", str(path), *SMALL]) == 2
     assert "is a file" in capsys.readouterr().err
+
+
+@pytest.mark.realdata
+def test_map_of_the_measured_phantom_small_region(data_dir, tmp_path, capsys):
+    out = tmp_path / "measured"
+    status = main(
+        [
+            "map",
+            "--phantom",
+            "measured",
+            "--data-dir",
+            str(data_dir),
+            "--out",
+            str(out),
+            "--json",
+            "--no-figures",
+            "--region=-0.12,-0.09,-0.38,-0.36",
+            "--resolution-mm",
+            "1",
+        ]
+    )
+    assert status == 0
+    result = json.loads(capsys.readouterr().out)
+    assert tuple(result) == METRIC_KEYS and result["points"] == 12
+    assert result["kappa_rmse_pct"] < 10.0
+    assert result["surface_rmse_mm"] < 0.5
+    # The rib near x = -10.6 cm of the measured map is found within 2 mm.
+    assert len(result["ribs_true"]) == len(result["ribs_found"]) == 1
+    assert result["ribs_found"][0] == pytest.approx(result["ribs_true"][0], abs=2e-3)
