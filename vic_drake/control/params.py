@@ -149,7 +149,7 @@ class StiffnessQpParams:
     force_max_N: list[float] = field(default_factory=lambda: [15.0, 15.0, 15.0])
     damping_ratio: float = 0.707
     solver: str = "osqp"
-    osqp_eps: float = 1e-9
+    osqp_eps: float = 1e-10
 
     def __post_init__(self):
         self.validate()

@@ -382,14 +382,22 @@ class StiffnessQp:
     active, and interior-point Clarabel fails on near-zero rows such as
     1e-12 k >= c that a vanishing error produces.
 
-    Scaling. For OSQP the decision variables are k scaled per axis,
+    Scaling. For OSQP every force row and the tank rows are scaled to unit
+    coefficients (the tank rows' a' k has coefficients ~1e-4: OSQP then hit
+    its iteration limit on such cases, found by the property tests), and
+    the decision variables are k scaled per axis,
     kk_i = k_i sqrt(2 (Q_i e_i^2 + R_i)), so that the cost's Hessian is the
     identity: in N/m (or uniformly in kN/m) the curvature ranges over 1e-5
     to 1 between axes (R = 1e-5, e_i from 0 to 2 cm) and OSQP's ADMM stops
     early along the flat axes (errors up to 0.3 N/m, measured). Clarabel
     (interior point, its own equilibration) is more accurate with k in kN/m
     and the cost normalised by its largest curvature (measured: max 1e-4
-    N/m against the exact solver vs ~1 N/m with the per-axis scaling).
+    N/m against the exact solver on the real logs vs ~1 N/m with the
+    per-axis scaling). Measured on 5,000 random problems (bounds, force and
+    tank rows active in all combinations, R from 1e-5 to 10): OSQP within
+    4e-7 N/m of the exact answer; Clarabel within 0.43 N/m, the worst cases
+    being flat axes (R = 1e-5, e_i ~ 0) whose optimum sits on a bound with a
+    zero multiplier, which the interior point approaches only loosely.
 
     Args:
         solver: "osqp", "clarabel" or "exact" (the latter skips the program
@@ -397,7 +405,7 @@ class StiffnessQp:
         osqp_eps: OSQP's eps_abs and eps_rel.
     """
 
-    def __init__(self, solver: str = "osqp", *, osqp_eps: float = 1e-9):
+    def __init__(self, solver: str = "osqp", *, osqp_eps: float = 1e-10):
         from pydrake.solvers import (
             ClarabelSolver,
             MathematicalProgram,
@@ -494,12 +502,25 @@ class StiffnessQp:
             f_hi = ei * (kmx[i] if ei > 0.0 else kmn[i])
             if f_lo_row <= f_lo and f_hi <= f_hi_row:  # Redundant over the box.
                 A[3 + i, i], lb[3 + i], ub[3 + i] = 0.0, -inf, inf
+            elif ei == 0.0:  # 0 in [F_min - D e_dot, F_max - D e_dot] fails.
+                return _fallback(problem, t0, "infeasible")
+            elif self._unit_hessian:  # OSQP: e s kk in [lo, hi] divided by |e s|.
+                c = abs(ei * s)
+                A[3 + i, i] = 1.0 if ei > 0.0 else -1.0
+                lb[3 + i], ub[3 + i] = f_lo_row / c, f_hi_row / c
             else:
                 A[3 + i, i], lb[3 + i], ub[3 + i] = ei * s, f_lo_row, f_hi_row
             A[6, i] = A[7, i] = a[i] * s
             a_low += a[i] * (kmn[i] if a[i] > 0.0 else kmx[i])
-        lb[6] = lb_energy if lb_energy > a_low else -inf
-        lb[7] = lb_power if lb_power > a_low else -inf
+        # Unit-norm tank rows (a' k ~ 1e-4 k otherwise: ADMM then stalls).
+        norm = math.sqrt(A[6, 0] ** 2 + A[6, 1] ** 2 + A[6, 2] ** 2)
+        if norm > 0.0 and self._unit_hessian:
+            A[6] /= norm
+            A[7] /= norm
+        else:
+            norm = 1.0
+        lb[6] = lb_energy / norm if lb_energy > a_low else -inf
+        lb[7] = lb_power / norm if lb_power > a_low else -inf
         ub[6] = ub[7] = inf
         if self._unit_hessian:
             self._cost.evaluator().UpdateCoefficients(Q, np.array(b))
