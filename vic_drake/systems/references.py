@@ -18,7 +18,6 @@ from pydrake.systems.framework import BasicVector, LeafSystem, ValueProducer
 
 from vic_drake.control.params import ControllerParams
 from vic_drake.control.references import (
-    constant_stiffness,
     force_references,
     in_contact,
     penetration,
@@ -151,9 +150,6 @@ class ForceReferenceSystem(LeafSystem):
     def _update(self, context, discrete_state):
         _, new_filt = self._cache.Eval(context)
         discrete_state.get_mutable_vector(self._filter_index).SetFromVector(new_filt)
-
-    def uses_constant_stiffness(self) -> bool:
-        return constant_stiffness(self._params.reference) is not None
 
     def get_ee_position_input_port(self):
         return self._position_port

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import copy
 
-import numpy as np
 from pydrake.systems.framework import BasicVector, LeafSystem
 
 from vic_drake.control.params import ControllerParams
@@ -46,6 +45,7 @@ class EnergyTankSystem(LeafSystem):
         tank (4): [T_J, power_W, sigma, enabled] after the committed tick
             (power 0, sigma 0, enabled 0 when the tick was inactive: CS, CF).
         energy (1): T_J, what the next QP tick sees.
+        x_t (1): the tank state (before the committed tick).
 
     State: x_t (1), discrete.
     """
@@ -111,8 +111,3 @@ class EnergyTankSystem(LeafSystem):
 
     def get_energy_output_port(self):
         return self._energy_port
-
-
-def empty_commit() -> np.ndarray:
-    """An inactive commit (no energy exchange)."""
-    return np.zeros(COMMIT_SIZE)
