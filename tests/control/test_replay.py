@@ -104,3 +104,15 @@ def test_replay_qp_command_errors(data_dir, capsys):
         == 2
     )
     assert "--R" in capsys.readouterr().err
+
+
+def test_native_stdout_goes_to_stderr_during_the_replay(capfd):
+    import os
+
+    from vic_drake.commands.control import native_stdout_to_stderr
+
+    with native_stdout_to_stderr():
+        os.write(1, b"native note\n")
+    print("json")
+    out, err = capfd.readouterr()
+    assert out == "json\n" and "native note" in err

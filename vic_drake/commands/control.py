@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
+import os
+import sys
 
 from vic_drake.commands.common import add_json_option, emit
 from vic_drake.errors import VicDrakeError
@@ -43,13 +46,36 @@ def register(subparsers) -> None:
     parser.set_defaults(handler=run_replay_qp)
 
 
+@contextlib.contextmanager
+def native_stdout_to_stderr():
+    """Sends what native code writes to file descriptor 1 to stderr.
+
+    OSQP's C code prints notes such as "Polishing not needed" on stdout even
+    with verbose off; with ``--json`` stdout must hold the JSON alone.
+    """
+    sys.stdout.flush()
+    try:
+        saved = os.dup(1)
+    except OSError:  # No real stdout (embedded use): nothing to protect.
+        yield
+        return
+    try:
+        os.dup2(2, 1)
+        yield
+    finally:
+        sys.stdout.flush()
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
 def run_replay_qp(args: argparse.Namespace) -> int:
     from vic_drake.control.replay import replay_bag
 
     r = args.r_weight
     if not (math.isfinite(r) and r > 0.0):
         raise VicDrakeError(f"--R must be a finite number > 0; got {r!r}")
-    result = replay_bag(args.bag_dir, r_weight=r, solver=args.solver)
+    with native_stdout_to_stderr():
+        result = replay_bag(args.bag_dir, r_weight=r, solver=args.solver)
     summary = result.summary()
     human = (
         f"replay-qp {args.bag_dir} (R = {r:g}, solver {summary['solver']}): "
