@@ -64,6 +64,19 @@ def test_scan_figures_draw_sim_and_real(tmp_path):
         plot_fig6({})
 
 
+def test_command_feedback_reads_the_tip_from_the_joint_command():
+    from dataclasses import replace
+
+    scenario = replace(synthetic_scenario("vs-vf"), controller_feedback="command")
+    diagram, _ = MakeScanDiagram(scenario)
+    diagram.GetSubsystemByName("commanded_tip")
+    df = run_scan(scenario, duration_s=0.05).df
+    # At rest at the start the commanded tip is where the arm is.
+    np.testing.assert_allclose(
+        df[["x_m", "y_m", "z_m"]].iloc[0], [0.036, -0.36, 0.12], atol=1e-3
+    )
+
+
 def test_run_scan_rejects_bad_input():
     with pytest.raises(VicDrakeError, match="duration_s"):
         run_scan(synthetic_scenario("cs"), duration_s=-1.0)
