@@ -19,6 +19,8 @@ Stages (see :data:`STAGES`):
   CS, CF with the phantom lifted and lowered; every log written as parquet
   with its scenario YAML beside it.
 - ``real_scans``: the paper's scan logs reduced to the same metrics.
+- ``compare_real``: (full mode) each real scan re-run in simulation on the
+  measured map and compared with its log.
 - ``claims``: C1-C7 (:mod:`vic_drake.claims`) -> ``claims.json``.
 - ``replay``: a Meshcat recording of one scan -> ``replay.html``.
 - ``report``: ``report.html`` (figures, tables, claims, metadata).
@@ -429,7 +431,8 @@ def stage_map(ctx: RunContext) -> dict:
     "sim". The paper's own GP map (``phantom_map/``) gives C3 "real".
     """
     from vic_drake.estimation.campaign import CampaignParams, run_campaign
-    from vic_drake.estimation.gp_maps import GpMapParams, gp_map
+    from vic_drake.estimation.gp_maps import build_tissue_map
+    from vic_drake.plots.maps import plot_stiffness_damping_maps, plot_surface_kappa
     from vic_drake.tissue import load_phantom
 
     out: dict = {}
@@ -446,51 +449,52 @@ def stage_map(ctx: RunContext) -> dict:
                {"campaign_params": params, "phantom": ctx.phantom_kind,
                 "lag_s": campaign.lag_s})
     pts = campaign.ok
-    res = 0.002 if ctx.options.quick else 0.001
-    x0, x1, y0, y1 = region
-    xs = np.arange(x0, x1 + 1e-9, res)
-    ys = np.arange(y0, y1 + 1e-9, res)
-    ctx.progress(f"  GP maps of kappa and lambda on {xs.size} x {ys.size} points")
-    gp_params = GpMapParams()
-    kappa = gp_map(pts["x_m"], pts["y_m"], pts["kappa_N_per_m_beta"], xs, ys, gp_params)
-    lam = gp_map(pts["x_m"], pts["y_m"], pts["lambda_N_s_per_m_beta1"], xs, ys, gp_params)
-    ctx.progress(f"  GP fits {kappa.fit_s + lam.fit_s:.1f} s, predictions "
-                 f"{kappa.predict_s + lam.predict_s:.1f} s")
-    out["ribs_sim"] = claims_mod.rib_prominences(xs, ys, kappa.mean)
+    res = 0.001 if ctx.options.quick else 1e-4
+    ctx.progress(f"  surface fit and GP maps every {res * 1e3:g} mm")
+    tmap = build_tissue_map(campaign.points, region, beta=campaign.beta, resolution_m=res,
+                            progress=lambda m: ctx.progress(f"  {m}"))
+    out["ribs_sim"] = claims_mod.rib_prominences(tmap.x_m, tmap.y_m, tmap.kappa)
     out["campaign"] = campaign
-    out["kappa_map"], out["lambda_map"] = kappa, lam
+    out["tissue_map"] = tmap
+    # Error of the estimated kappa against the phantom, on a 1 mm subgrid.
+    step = max(1, int(round(1e-3 / res)))
+    xs, ys = tmap.x_m[::step], tmap.y_m[::step]
     truth = phantom.sample(*np.meshgrid(xs, ys, indexing="ij"))
-    kerr = kappa.mean - truth.kappa
+    kerr = tmap.kappa[::step, ::step] - truth.kappa
     out["kappa_rel_rmse"] = float(np.sqrt(np.mean(kerr**2)) / np.mean(truth.kappa))
     ctx.add_figure(
         "Fig. 4: GP maps of kappa and lambda",
-        f"GP maps estimated from {len(pts)} simulated palpations on a 1 cm grid of the "
-        f"region x {region[0]:.3f}..{region[1]:.3f} m, y {region[2]:.3f}..{region[3]:.3f} m of the "
-        f"{ctx.phantom_kind} phantom (top), and the paper's measured GP map (bottom, when "
-        f"the data is there). kappa relative RMS error vs the phantom: "
-        f"{out['kappa_rel_rmse']:.1%}. Detected ribs marked.",
-        _plot_maps(kappa, lam, pts, real_map, out["ribs_sim"],
+        f"GP maps every {res * 1e3:g} mm from {len(pts)} palpations simulated on a 1 cm grid "
+        f"of the {ctx.phantom_kind} phantom over x {region[0]:.3f}..{region[1]:.3f} m, "
+        f"y {region[2]:.3f}..{region[3]:.3f} m (dots: palpation points).",
+        plot_stiffness_damping_maps(tmap), "fig4_gp_maps.png")
+    ctx.add_figure(
+        "Fig. 4 (comparison): estimated maps and the paper's measured map",
+        "Top: the estimated maps with the detected ribs (red dotted lines); bottom (with "
+        "the paper's data): the paper's own GP map. kappa relative RMS error of the "
+        f"estimate against the phantom: {out['kappa_rel_rmse']:.1%}.",
+        _plot_maps(tmap, pts, real_map, out["ribs_sim"],
                    claims_mod.rib_prominences(real_map.x_m, real_map.y_m, real_map.kappa)
                    if real_map is not None else None),
-        "fig4_gp_maps.png")
+        "fig4_maps_vs_paper.png")
     ctx.add_figure(
         "Fig. 5: surface with elasticity",
-        "Palpated surface heights coloured by the estimated kappa (the paper's Fig. 5 "
-        "projects the kappa map on the GRIDFIT surface).",
-        _plot_surface(pts), "fig5_surface_kappa.png")
+        "The GRIDFIT-like surface through the contact points, coloured by the kappa map "
+        "(the paper's Fig. 5).", plot_surface_kappa(tmap), "fig5_surface_kappa.png")
     return out
 
 
-def _plot_maps(kappa, lam, pts, real_map, ribs_sim, ribs_real):
+def _plot_maps(tmap, pts, real_map, ribs_sim, ribs_real):
     from matplotlib.figure import Figure
 
     rows = 2 if real_map is not None else 1
     fig = Figure(figsize=(11, 3.6 * rows))
     axes = fig.subplots(rows, 2, squeeze=False)
-    ext = [kappa.x_m[0], kappa.x_m[-1], kappa.y_m[0], kappa.y_m[-1]]
+    step = max(1, int(np.ceil(tmap.x_m.size / 400)))
 
-    def show(ax, grid, title, extent, ribs=None):
-        im = ax.imshow(grid.T, origin="lower", extent=extent, aspect="equal", cmap="viridis")
+    def show(ax, x, y, grid, title, ribs=None):
+        ext = [x[0], x[-1], y[0], y[-1]]
+        im = ax.imshow(grid.T, origin="lower", extent=ext, aspect="equal", cmap="viridis")
         fig.colorbar(im, ax=ax, shrink=0.8)
         ax.set_title(title, fontsize=9)
         ax.set_xlabel("x [m]")
@@ -498,29 +502,18 @@ def _plot_maps(kappa, lam, pts, real_map, ribs_sim, ribs_real):
         for xr in (ribs or {}).get("rib_position_m", []):
             ax.axvline(xr, color="r", ls=":", lw=1)
 
-    show(axes[0, 0], kappa.mean, "kappa, estimated (sim) [N/m^beta]", ext, ribs_sim)
+    xs, ys = tmap.x_m[::step], tmap.y_m[::step]
+    show(axes[0, 0], xs, ys, tmap.kappa[::step, ::step], "kappa, estimated [N/m^beta]",
+         ribs_sim)
     axes[0, 0].plot(pts["x_m"], pts["y_m"], "k.", ms=2)
-    show(axes[0, 1], lam.mean, "lambda, estimated (sim) [N s/m^(beta+1)]", ext)
+    show(axes[0, 1], xs, ys, tmap.lam[::step, ::step],
+         "lambda, estimated [N s/m^(beta+1)]")
     if real_map is not None:
-        rext = [real_map.x_m[0], real_map.x_m[-1], real_map.y_m[0], real_map.y_m[-1]]
-        show(axes[1, 0], real_map.kappa, "kappa, paper's measured map", rext, ribs_real)
-        show(axes[1, 1], real_map.lam, "lambda, paper's measured map", rext)
+        show(axes[1, 0], real_map.x_m, real_map.y_m, real_map.kappa,
+             "kappa, the paper's measured map", ribs_real)
+        show(axes[1, 1], real_map.x_m, real_map.y_m, real_map.lam,
+             "lambda, the paper's measured map")
     fig.tight_layout()
-    return fig
-
-
-def _plot_surface(pts):
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(7, 5))
-    ax = fig.add_subplot(projection="3d")
-    sc = ax.scatter(pts["x_m"], pts["y_m"], pts["surface_z_m"], c=pts["kappa_N_per_m_beta"],
-                    cmap="viridis", s=12)
-    fig.colorbar(sc, ax=ax, shrink=0.6, label="kappa [N/m^beta]")
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.set_zlabel("surface z [m]")
-    ax.view_init(elev=30, azim=60)
     return fig
 
 
@@ -773,6 +766,65 @@ def stage_replay(ctx: RunContext) -> dict:
     return {"path": path, "bytes": path.stat().st_size, "scenario": scenario.name}
 
 
+def _compare_real_job(args):
+    """Worker: one real experiment re-run in simulation (module-level for spawn)."""
+    from vic_drake.experiments import compare_real
+
+    bag, data_dir = args
+    return compare_real(bag, data_dir=data_dir, return_frames=True)
+
+
+#: Keys of vic_drake.experiments.compare_real shown in the report.
+COMPARE_REAL_KEYS = ("controller", "duration_s", "force_rmse_N", "force_peak_err_N",
+                     "z_rmse_mm", "kz_corr", "tank_min_J", "rtf")
+
+
+def stage_compare_real(ctx: RunContext) -> dict:
+    """Each real scan re-run in simulation on the measured map, compared with its log.
+
+    :func:`vic_drake.experiments.compare_real` (logged target, controller
+    settings, estimated phantom lift of the ``_dist`` logs). Full mode only.
+    """
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    if ctx.data_dir is None:
+        raise StageSkipped("no real data (pass --data-dir or set VIC_DRAKE_DATA)")
+    if ctx.options.quick:
+        raise StageSkipped("full mode only (six more simulations of 20-26 s)")
+    names = sorted(set(REAL_SCAN_LOGS.values()))
+    workers = max(1, min(len(names), os.cpu_count() or 1))
+    out = {}
+    with ProcessPoolExecutor(max_workers=workers,
+                             mp_context=multiprocessing.get_context("spawn")) as pool:
+        jobs = {name: pool.submit(_compare_real_job,
+                                  (ctx.data_dir / "experiments" / name, ctx.data_dir))
+                for name in names}
+        for name, fut in jobs.items():
+            out[name] = fut.result()
+            ctx.progress(f"  {name}: force RMSE {out[name][0]['force_rmse_N']:.2f} N, "
+                         f"z RMSE {out[name][0]['z_rmse_mm']:.1f} mm")
+    from vic_drake.report import ReportTable
+
+    ctx.tables.append(ReportTable(
+        "Real experiments re-run in simulation (measured map)",
+        ["log", *COMPARE_REAL_KEYS],
+        [[name, *(res[0].get(k) for k in COMPARE_REAL_KEYS)] for name, res in out.items()],
+        "vic_drake.experiments.compare_real: each real scan's target, controller settings "
+        "and (for _dist logs) estimated phantom lift, simulated and compared with the log "
+        "after time alignment. kz_corr: correlation of simulated and logged K_z."))
+    from vic_drake.plots.scans import plot_comparison
+
+    for name in ("test_nardi_matForce_lowR", "test_compliance_control400_dist"):
+        if name in out:
+            _, sim_df, real_df = out[name]
+            ctx.add_figure(f"Real vs simulated: {name}",
+                           "The real log and its simulation on the measured map.",
+                           plot_comparison(sim_df, real_df, title=name),
+                           f"compare_real_{name}.png")
+    return {name: res[0] for name, res in out.items()}
+
+
 # --- Claims and report --------------------------------------------------------
 
 
@@ -954,6 +1006,7 @@ STAGES: tuple[tuple[str, Callable[[RunContext], Any]], ...] = (
     ("real_scans", stage_real_scans),
     ("scans", stage_scans),
     ("replay", stage_replay),
+    ("compare_real", stage_compare_real),
     ("claims", stage_claims),
     ("report", stage_report),
 )
