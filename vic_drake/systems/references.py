@@ -111,7 +111,9 @@ class ForceReferenceSystem(LeafSystem):
             values = np.zeros(13)
             values[3:6] = (qp.force_min_N[0], qp.force_min_N[1], -qp.force_max_N[2])
             values[11] = 1.0
-            return values, filt
+            # Restart the filter: the next good sample only records its height
+            # (no rate spike across the gap).
+            return values, [0.0, *filt[1:]]
         surface_z, dz_dx, dz_dy, kappa, lam = self._sample(p_WP[0], p_WP[1])
         if self._mode == "moving_average":
             new_filt, z_surf_dot = surface_velocity_step(filt, surface_z, self._dt)
