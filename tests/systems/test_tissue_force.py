@@ -6,8 +6,8 @@ from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.math import SpatialVelocity
 from pydrake.multibody.tree import BodyIndex
 
-from vic_drake.systems.tissue_force import GridLookup, TissueForceElement, tip_contact
-from vic_drake.tissue import GridPhantom, hunt_crossley_force
+from vic_drake.systems.tissue_force import TissueForceElement, tip_contact
+from vic_drake.tissue import GridPhantom, PointLookup, hunt_crossley_force
 
 
 def _plane_phantom(z0=0.1, gx=0.2, gy=-0.1, kappa=3000.0, lam=30000.0):
@@ -102,7 +102,7 @@ def test_grid_lookup_equals_the_grid_phantom():
             lam=2e4 + 1e3 * np.sin(20 * Y),
             lookup=lookup,
         )
-        fast = GridLookup(ph)
+        fast = PointLookup(ph)
         # Inside, on nodes, and outside the grid (clamped, zero gradient across).
         pts = np.concatenate(
             [
@@ -122,7 +122,7 @@ def test_grid_lookup_of_the_synthetic_chest_is_close():
     from vic_drake.tissue import SyntheticChestPhantom
 
     ph = SyntheticChestPhantom()
-    fast = GridLookup(ph, resolution_m=0.0005)
+    fast = PointLookup(ph, resolution_m=0.0005)
     rng = np.random.default_rng(1)
     for x, y in rng.uniform([-0.2, -0.5], [0.08, -0.2], (100, 2)):
         a, b = ph.sample(x, y), fast.sample(x, y)

@@ -175,77 +175,10 @@ def uses_qp(ref: ReferenceParams) -> bool:
 def scalar_sampler(phantom):
     """A fast scalar lookup ``f(x, y) -> (surface_z, dz_dx, dz_dy, kappa, lam)``.
 
-    ``Phantom.sample`` is vectorised numpy and costs ~90 us for one point,
-    half of a tick's budget. For a :class:`~vic_drake.tissue.phantom.GridPhantom`
-    this returns the same bilinear or nearest lookup (same clamping, same
-    zero slope across the edge) in plain Python on the phantom's own grids
-    (~2 us); tests check it against ``sample`` point by point. Any other
-    phantom falls back to ``sample``.
+    ``Phantom.sample`` is vectorised numpy and costs 50-100 us for one
+    point, a large share of a tick's budget; this returns the phantom's
+    cached :class:`~vic_drake.tissue.PointLookup` (a few us; exact for a
+    GridPhantom, a 0.5 mm rasterization otherwise).
     """
-    from bisect import bisect_right
+    return phantom.point_lookup()
 
-    from vic_drake.tissue.phantom import GridPhantom
-
-    if not isinstance(phantom, GridPhantom):
-
-        def sample(x, y):
-            s = phantom.sample(x, y)
-            return (float(s.surface_z_m), float(s.dz_dx), float(s.dz_dy),
-                    float(s.kappa), float(s.lam))  # fmt: skip
-
-        return sample
-
-    xs, ys = phantom.x_m.tolist(), phantom.y_m.tolist()
-    grids = [
-        g.tolist()
-        for g in (
-            phantom.surface_m,
-            phantom.dz_dx_grid,
-            phantom.dz_dy_grid,
-            phantom.kappa_grid,
-            phantom.lam_grid,
-        )  # fmt: skip
-    ]
-    nx, ny = len(xs), len(ys)
-    x_lo, x_hi, y_lo, y_hi = xs[0], xs[-1], ys[0], ys[-1]
-    zg, gxg, gyg, kg, lg = grids
-    nearest = phantom.lookup == "nearest"
-
-    def sample(x, y):
-        # Same clamped brackets as GridPhantom's _axis_weights, in scalars.
-        qx = x_lo if x < x_lo else (x_hi if x > x_hi else x)
-        i1 = bisect_right(xs, qx)
-        i1 = 1 if i1 < 1 else (nx - 1 if i1 > nx - 1 else i1)
-        i0 = i1 - 1
-        wx = (qx - xs[i0]) / (xs[i1] - xs[i0])
-        qy = y_lo if y < y_lo else (y_hi if y > y_hi else y)
-        j1 = bisect_right(ys, qy)
-        j1 = 1 if j1 < 1 else (ny - 1 if j1 > ny - 1 else j1)
-        j0 = j1 - 1
-        wy = (qy - ys[j0]) / (ys[j1] - ys[j0])
-        in_x = x_lo <= x <= x_hi
-        in_y = y_lo <= y <= y_hi
-        if nearest:
-            i, j = round(i0 + wx), round(j0 + wy)  # Half to even, as np.rint.
-            return (zg[i][j], gxg[i][j] if in_x else 0.0, gyg[i][j] if in_y else 0.0,
-                    kg[i][j], lg[i][j])  # fmt: skip
-        w00 = (1.0 - wx) * (1.0 - wy)
-        w10 = wx * (1.0 - wy)
-        w01 = (1.0 - wx) * wy
-        w11 = wx * wy
-        r0, r1 = zg[i0], zg[i1]
-        z = w00 * r0[j0] + w10 * r1[j0] + w01 * r0[j1] + w11 * r1[j1]
-        r0, r1 = kg[i0], kg[i1]
-        k = w00 * r0[j0] + w10 * r1[j0] + w01 * r0[j1] + w11 * r1[j1]
-        r0, r1 = lg[i0], lg[i1]
-        lam = w00 * r0[j0] + w10 * r1[j0] + w01 * r0[j1] + w11 * r1[j1]
-        gx = gy = 0.0
-        if in_x:
-            r0, r1 = gxg[i0], gxg[i1]
-            gx = w00 * r0[j0] + w10 * r1[j0] + w01 * r0[j1] + w11 * r1[j1]
-        if in_y:
-            r0, r1 = gyg[i0], gyg[i1]
-            gy = w00 * r0[j0] + w10 * r1[j0] + w01 * r0[j1] + w11 * r1[j1]
-        return z, gx, gy, k, lam
-
-    return sample

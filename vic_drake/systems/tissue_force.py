@@ -39,7 +39,6 @@ Geometry and signs (all in the world frame W = the rig's ``base_link``):
 
 from __future__ import annotations
 
-import bisect
 from dataclasses import dataclass
 
 import numpy as np
@@ -51,7 +50,7 @@ from pydrake.multibody.tree import BodyIndex
 from pydrake.systems.framework import LeafSystem, ValueProducer
 
 from vic_drake.errors import VicDrakeError
-from vic_drake.tissue import GridPhantom, Phantom, TissueSample, hunt_crossley_force
+from vic_drake.tissue import Phantom, PointLookup, hunt_crossley_force
 
 
 @dataclass(frozen=True)
@@ -103,79 +102,8 @@ class _Cached:
     p_WPh: np.ndarray
 
 
-class GridLookup:
-    """Fast scalar lookup of a phantom on a regular grid (the per-step query).
-
-    The force element queries one point per plant step; a vectorised
-    ``Phantom.sample`` costs 100-500 us of numpy overhead per scalar call.
-    This class answers the same query in a few microseconds with plain
-    Python floats:
-
-    - a :class:`~vic_drake.tissue.GridPhantom` is used as is (its grids,
-      gradient grids and lookup mode), so the result equals its ``sample``;
-    - any other phantom is rasterized once on a ``resolution_m`` grid over
-      its bounds (surface, gradient, kappa and lambda sampled at the nodes,
-      bilinear in between; 0.5 mm keeps the synthetic chest's surface within
-      micrometres).
-
-    Outside the grid queries clamp to the edge with zero gradient across it,
-    as the phantoms do. ``sample`` returns a TissueSample of floats.
-    """
-
-    def __init__(self, phantom: Phantom, *, resolution_m: float = 0.0005):
-        if not (np.isfinite(resolution_m) and resolution_m > 0):
-            raise VicDrakeError(f"resolution_m must be > 0, got {resolution_m!r}")
-        self.beta = float(phantom.beta)
-        self.name = getattr(phantom, "name", "phantom")
-        if isinstance(phantom, GridPhantom):
-            xs, ys = phantom.x_m, phantom.y_m
-            grids = (
-                phantom.surface_m,
-                phantom.dz_dx_grid,
-                phantom.dz_dy_grid,
-                phantom.kappa_grid,
-                phantom.lam_grid,
-            )
-            self.nearest = phantom.lookup == "nearest"
-        else:
-            xs, ys, smp = phantom.rasterize(resolution_m)
-            grids = (smp.surface_z_m, smp.dz_dx, smp.dz_dy, smp.kappa, smp.lam)
-            self.nearest = False
-        self._xs, self._ys = [float(v) for v in xs], [float(v) for v in ys]
-        self._grids = [np.asarray(g, float).tolist() for g in grids]
-        self.bounds = (self._xs[0], self._xs[-1], self._ys[0], self._ys[-1])
-
-    @staticmethod
-    def _axis(axis, q):
-        """(i0, w1, inside) of q on an increasing axis, clamped."""
-        inside = axis[0] <= q <= axis[-1]
-        qc = min(max(q, axis[0]), axis[-1])
-        i1 = min(max(bisect.bisect_right(axis, qc), 1), len(axis) - 1)
-        i0 = i1 - 1
-        return i0, (qc - axis[i0]) / (axis[i1] - axis[i0]), inside
-
-    def sample(self, x, y) -> TissueSample:
-        i, wx, in_x = self._axis(self._xs, float(x))
-        j, wy, in_y = self._axis(self._ys, float(y))
-        if self.nearest:
-            i, j = i + (wx >= 0.5), j + (wy >= 0.5)
-            values = [g[i][j] for g in self._grids]
-        else:
-            values = [
-                (1 - wx) * (1 - wy) * g[i][j]
-                + wx * (1 - wy) * g[i + 1][j]
-                + (1 - wx) * wy * g[i][j + 1]
-                + wx * wy * g[i + 1][j + 1]
-                for g in self._grids
-            ]
-        surface, gx, gy, kappa, lam = values
-        return TissueSample(
-            surface, gx if in_x else 0.0, gy if in_y else 0.0, kappa, lam
-        )
-
-
 def tip_contact(
-    phantom: Phantom | GridLookup,
+    phantom: Phantom | PointLookup,
     p_WT,
     v_WT,
     p_WPh=(0.0, 0.0, 0.0),
@@ -189,7 +117,7 @@ def tip_contact(
 
     Args:
         phantom: the tissue map, in the phantom body's frame (a Phantom or
-            its :class:`GridLookup`).
+            its :class:`~vic_drake.tissue.PointLookup`).
         p_WT: tip position in W, m (3,).
         v_WT: tip translational velocity in W, m/s (3,).
         p_WPh: phantom body origin in W (its map offset plus lift), m (3,).
@@ -299,7 +227,7 @@ class TissueForceElement(LeafSystem):
             p_BT: tip position in B's frame, m (3,).
             phantom_body_index: the phantom body (receives the reaction).
             lookup_resolution_m: grid of the per-step lookup for phantoms
-                that are not grids (see :class:`GridLookup`), m.
+                that are not grids (see :class:`~vic_drake.tissue.PointLookup`), m.
             friction_coefficient, slip_speed_m_per_s: optional tangential
                 friction (see :func:`tip_contact`); 0 = the paper's model.
             along_normal: force along the surface normal instead of
@@ -317,7 +245,7 @@ class TissueForceElement(LeafSystem):
         self._along_normal = bool(along_normal)
         self._slip = float(slip_speed_m_per_s)
         super().__init__()
-        self._phantom = GridLookup(phantom, resolution_m=lookup_resolution_m)
+        self._phantom = phantom.point_lookup(resolution_m=lookup_resolution_m)
         self._indenter = indenter_body_index
         self._phantom_body = phantom_body_index
         self._p_BT = np.asarray(p_BT, float).reshape(3)

@@ -8,6 +8,7 @@ from vic_drake.tissue.models import (
 from vic_drake.tissue.phantom import (
     GridPhantom,
     Phantom,
+    PointLookup,
     SyntheticChestParams,
     SyntheticChestPhantom,
     TissueSample,
@@ -17,6 +18,7 @@ from vic_drake.tissue.phantom import (
 __all__ = [
     "GridPhantom",
     "Phantom",
+    "PointLookup",
     "SyntheticChestParams",
     "SyntheticChestPhantom",
     "TissueSample",
