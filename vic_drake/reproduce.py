@@ -954,6 +954,17 @@ REPORT_NOTES = (
 )
 
 
+_PAPER_ORDER = (("Fig. 2", 2.0), ("Table I", 2.5), ("Beta sweep", 2.6), ("Fig. 3", 3.0),
+                ("Fig. 4", 4.0), ("Fig. 5", 5.0), ("Fig. 6", 6.0), ("CS and CF", 6.5),
+                ("Fig. 7", 7.0), ("Real scan logs", 8.0), ("Simulated scans: metrics", 8.1),
+                ("Real experiments", 8.5), ("Real vs simulated", 8.6))
+
+
+def _paper_order(title: str) -> float:
+    """Rank of a figure or table: the paper's order, then the rest."""
+    return next((rank for prefix, rank in _PAPER_ORDER if title.startswith(prefix)), 9.0)
+
+
 def stage_report(ctx: RunContext) -> dict:
     """report.html: claims, tables, figures, files, stage times, versions."""
     from vic_drake.report import ReportContent, write_report
@@ -980,8 +991,8 @@ def stage_report(ctx: RunContext) -> dict:
             "logs where they exist."
         ),
         claims=claims,
-        figures=ctx.figures,
-        tables=ctx.tables,
+        figures=sorted(ctx.figures, key=lambda f: _paper_order(f.title)),
+        tables=sorted(ctx.tables, key=lambda t: _paper_order(t.title)),
         metadata={
             **{f"version {k}": v for k, v in _versions().items()},
             "data folder": str(ctx.data_dir) if ctx.data_dir else "not found",
