@@ -86,6 +86,25 @@ def test_run_scan_rejects_bad_input():
         synthetic_scenario("pid")
 
 
+def test_controller_reads_the_map_with_its_own_lookup():
+    from dataclasses import replace
+
+    from vic_drake.experiments import _controller_phantom
+    from vic_drake.scenario import PhantomConfig
+    from vic_drake.tissue.phantom import GridPhantom
+
+    xs, ys = np.array([0.0, 0.01]), np.array([0.0, 0.01])
+    grid = np.array([[1000.0, 2000.0], [3000.0, 4000.0]])
+    tissue = GridPhantom(x_m=xs, y_m=ys, z_m=np.zeros((2, 2)), kappa=grid, lam=grid)
+    tissue.point_lookup()  # The tissue's (bilinear) fast lookup is cached first.
+    scenario = replace(
+        synthetic_scenario("vs-vf"), phantom=PhantomConfig(kind="measured")
+    )
+    ctrl = _controller_phantom(scenario, tissue)
+    assert ctrl.point_lookup()(0.004, 0.001)[3] == pytest.approx(1000.0)  # Nearest.
+    assert tissue.point_lookup()(0.004, 0.001)[3] == pytest.approx(1900.0)  # Bilinear.
+
+
 @pytest.mark.realdata
 def test_real_log_scenarios(data_dir):
     from vic_drake.realdata import read_bag

@@ -24,7 +24,6 @@ comparison with a real bag (:func:`compare_real`) also live here; the
 
 from __future__ import annotations
 
-import copy
 import re
 import time
 from dataclasses import dataclass, replace
@@ -89,14 +88,26 @@ def load_scenario_phantom(scenario: Scenario, *, data_dir=None):
 
 
 def _controller_phantom(scenario: Scenario, phantom):
-    """The map the controller reads: the tissue, or the same map looked up as configured."""
+    """The map the controller reads: the tissue's map with the controller's lookup.
+
+    A separate GridPhantom (sharing the arrays), not a copy: a phantom caches
+    its fast point lookup, and a copy would inherit the tissue's.
+    """
     from vic_drake.tissue.phantom import GridPhantom
 
     lookup = scenario.phantom.controller_lookup
     if isinstance(phantom, GridPhantom) and phantom.lookup != lookup:
-        other = copy.copy(phantom)
-        other.lookup = lookup
-        return other
+        return GridPhantom(
+            x_m=phantom.x_m,
+            y_m=phantom.y_m,
+            z_m=phantom.surface_m - phantom.surface_offset_m,
+            kappa=phantom.kappa_grid,
+            lam=phantom.lam_grid,
+            beta=phantom.beta,
+            surface_offset_m=phantom.surface_offset_m,
+            lookup=lookup,
+            name=f"{phantom.name} ({lookup})",
+        )
     return phantom
 
 
