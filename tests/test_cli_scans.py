@@ -63,6 +63,7 @@ def test_scan_command_runs_a_scenario_file(tmp_path, capsys):
     )
     out = json.loads(capsys.readouterr().out)
     assert out["controller"] == "cs" and out_file.is_file()
+    assert out["force_rmse_N"] is None  # CS has no force reference.
     assert (tmp_path / "log.scenario.yaml").is_file()
 
 

@@ -181,7 +181,10 @@ def run_scan_command(args: argparse.Namespace) -> int:
         "controller": scenario.controller.reference.controller,
         "duration_s": result.sim_s,
         "rtf": result.rtf,
-        "force_rmse_N": metrics.force_rmse_N(df),
+        # CS has no force reference: its RMSE against one is undefined.
+        "force_rmse_N": None
+        if scenario.controller.reference.controller == "cs"
+        else metrics.force_rmse_N(df),
         "force_range_N": list(metrics.force_range_N(df)),
         "force_peak_N": metrics.peak_force_N(df),
         "tank_min_J": metrics.tank_min_J(df),
