@@ -123,7 +123,7 @@ def test_static_press_sensor_reads_the_hunt_crossley_force_once(phantom):
 
 def test_sensor_lags_the_tissue_force_by_the_set_samples(phantom):
     station, context, _ = _pressing_station(
-        phantom, 0.005, sensor_noise_std_N=(0.0, 0.0, 0.0)
+        phantom, 0.005, sensor_lag_samples=28, sensor_noise_std_N=(0.0, 0.0, 0.0)
     )
     simulator = Simulator(station, context)
     simulator.AdvanceTo(0.2)

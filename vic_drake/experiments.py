@@ -674,7 +674,7 @@ def synthetic_scenario(controller: str, *, disturbed: bool = False) -> Scenario:
     default z gains, CF 7 N, VS-CF 7 N with R = 0.1, VS-VF eps_d = 8 mm,
     F_min = -9 N, R = 1e-5). ``disturbed`` adds :data:`SYNTHETIC_LIFTS`.
     """
-    from vic_drake.control.params import ControllerParams, ReferenceParams
+    from vic_drake.control.params import ReferenceParams
 
     if controller not in ("cs", "cf", "vs-cf", "vs-vf"):
         raise VicDrakeError(
@@ -690,8 +690,12 @@ def synthetic_scenario(controller: str, *, disturbed: bool = False) -> Scenario:
     elif controller == "cf":
         ref = replace(ref, force_ref_N=DEFAULT_CF_FORCE_N)
     r = DEFAULT_R.get(controller, 0.1)
-    ctrl = ControllerParams(reference=ref)
-    ctrl = replace(ctrl, qp=replace(ctrl.qp, r_weight=[r, r, r]))
+    # The default scenario's controller carries the scans' QP solver.
+    ctrl = replace(
+        base.controller,
+        reference=ref,
+        qp=replace(base.controller.qp, r_weight=[r, r, r]),
+    )
     kind = "disturbance" if disturbed else "nominal"
     lifts = [
         PhantomLift(start_s=a, height_m=b, rise_s=c, hold_s=d, fall_s=e)

@@ -293,40 +293,18 @@ class LoggingConfig:
         _number("LoggingConfig", "period_s", self.period_s, low=0.0, low_open=True)
 
 
-def _closed_loop_station() -> StationParams:
-    """The station of a closed-loop scan: StationParams without sensor lag.
-
-    The logs show the force trailing the logged pose by 28 ticks (56 ms),
-    but that delay is not in the real control loop: replaying the real
-    experiments on the measured map with the 28-tick lag inside the loop
-    makes the FDCC force loop ring at about 2.5 Hz over the stiff ribs
-    (test_tracking5: force RMSE against the log 1.51 N, K_z correlation
-    0.67; test_nardi_matForce_lowR: 2.34 N, 0.51), which the real rig did
-    not do; without it the same runs match the logs (0.30 N, 0.89; 0.65 N,
-    0.76). The logged pose is most likely the FDCC's command, which the arm
-    follows with the servo's delay, so the 56 ms sit between the logged
-    pose and the motion, not in the sensor.
-    """
-    return StationParams(sensor_lag_samples=0)
-
-
-def _scan_fdcc() -> FdccParams:
-    """The FDCC of a scan: FdccParams with its pose error on the measured joints.
-
-    FZI's code takes the pose error from its own last command
-    (``pose_feedback="command"``); in this simulation, whose joint servo
-    trails the command, that makes the VS-VF replay of
-    test_nardi_matForce_lowR ring (force RMSE against the log 2.25 N, K_z
-    correlation 0.66) where the measured pose reproduces the log (0.65 N,
-    0.76); the VS-CF replay is good with either.
-    """
-    return FdccParams(pose_feedback="measured")
+#: The stiffness QP solver of the scans: the closed-form solver (the same K
+#: as OSQP's within 1e-9 N/m on the real logs, about 10x cheaper per tick;
+#: see :class:`vic_drake.control.params.StiffnessQpParams`). Set
+#: ``controller.qp.solver: osqp`` in a scenario to run Drake's
+#: MathematicalProgram instead.
+SCAN_QP_SOLVER = "exact"
 
 
 def _vs_vf_controller() -> ControllerParams:
     """VS-VF as on the real rig (test_nardi_matForce_lowR: R = 1e-5)."""
     return ControllerParams(
-        qp=StiffnessQpParams(r_weight=[1e-5, 1e-5, 1e-5]),
+        qp=StiffnessQpParams(r_weight=[1e-5, 1e-5, 1e-5], solver=SCAN_QP_SOLVER),
         reference=ReferenceParams(controller="vs-vf"),
     )
 
@@ -339,12 +317,12 @@ class Scenario:
         name: label of the run (used in reports and file names).
         description: free text (which paper figure or real log it mirrors).
         phantom: the tissue.
-        station: the UR3e + F/T sensor + probe + phantom plant. Default:
-            StationParams with no sensor lag in the loop (see
-            :func:`_closed_loop_station`).
+        station: the UR3e + F/T sensor + probe + phantom plant
+            (default StationParams(): no sensor lag in the loop, see there).
         controller: the variable impedance controller (tank, QP, reference).
         fdcc: the forward-dynamics compliance controller that turns
-            stiffness and target force into joint position commands.
+            stiffness and target force into joint position commands
+            (default FdccParams(): pose error on the measured joints).
         trajectory: the target x_d(t).
         disturbance: the phantom lift z_offset(t).
         logging: recording period.
@@ -356,9 +334,9 @@ class Scenario:
     name: str = "vs_vf_nominal_synthetic"
     description: str = ""
     phantom: PhantomConfig = field(default_factory=PhantomConfig)
-    station: StationParams = field(default_factory=lambda: _closed_loop_station())
+    station: StationParams = field(default_factory=StationParams)
     controller: ControllerParams = field(default_factory=lambda: _vs_vf_controller())
-    fdcc: FdccParams = field(default_factory=lambda: _scan_fdcc())
+    fdcc: FdccParams = field(default_factory=FdccParams)
     trajectory: TrajectoryConfig = field(default_factory=TrajectoryConfig)
     disturbance: DisturbanceConfig = field(default_factory=DisturbanceConfig)
     logging: LoggingConfig = field(default_factory=LoggingConfig)

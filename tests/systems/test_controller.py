@@ -273,6 +273,7 @@ def test_surface_velocity_moving_average_in_the_system(sloped):
     tick(diagram, context)  # Records the height under P_WP.
     p2 = P_WP + np.array([-0.001, 0.0, 0.0])  # 1 mm along -x: surface 0.2 mm lower.
     diagram.GetInputPort("ee_position").FixValue(context, p2)
+    tick(diagram, context)  # The state ports publish what this tick used.
     ref = diagram.GetSubsystemByName("force_reference")
     contact = ref.get_contact_output_port().Eval(ref.GetMyContextFromRoot(context))
     z_rate = (0.2 * -0.001) / 0.002  # One finite difference, averaged over 10 samples.
@@ -293,6 +294,7 @@ def test_surface_velocity_gradient_mode(sloped):
         diagram.GetInputPort(name).FixValue(context, value)
     eps_dot = 0.2 * V_WP[0] - V_WP[2]  # grad z . v minus z_dot.
     f_ref_z = -(KAPPA + LAM * eps_dot) * 0.008**BETA
+    tick(diagram, context)
     assert out(diagram, context, "force_reference")[2] == pytest.approx(
         f_ref_z, rel=1e-12
     )

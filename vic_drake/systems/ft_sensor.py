@@ -13,8 +13,15 @@ Reading pipeline (every ``period_s``, 500 Hz on the rig):
    orientation (its weight held up by the sensor), so the reading is zero
    in free air at rest in any orientation;
 3. add zero-mean Gaussian noise (standard deviations per axis);
-4. delay by ``lag_samples`` periods (the real sensor's filter lag, about
-   28 samples at 500 Hz), then add a constant bias.
+4. delay by ``lag_samples`` periods (0 by default; the real logs pair
+   each pose with the force 28 samples later, see
+   :class:`vic_drake.station.StationParams`), then add a constant bias;
+5. express the reading's force in W with the sensor's orientation at the
+   sampling instant.
+
+The reading is discrete state published with ``DeclareStateOutputPort``:
+every consumer in a tick (controller, FDCC, loggers) reads the stored
+sample, nothing is recomputed when the plant moves between samples.
 
 Sign convention: the reading is the force the sensor applies to the tool
 side. When the probe presses down into the body the tissue pushes the tool
@@ -31,7 +38,7 @@ from pydrake.common.value import AbstractValue
 from pydrake.math import RigidTransform
 from pydrake.multibody.math import SpatialForce
 from pydrake.multibody.tree import BodyIndex, JointIndex
-from pydrake.systems.framework import BasicVector, LeafSystem
+from pydrake.systems.framework import LeafSystem
 
 from vic_drake.errors import VicDrakeError
 
@@ -76,9 +83,11 @@ class ForceTorqueSensor(LeafSystem):
             unconnected the reading is noise free.
     Output ports:
         wrench_S: (6,) reading ``[tau; f]`` in the sensor frame S (N m, N).
-        force_W: (3,) the reading's force expressed in W with the current
-            orientation of S, N (negative z = pressing down into the body).
-    State: a discrete buffer of the last ``lag_samples + 1`` tared samples.
+        force_W: (3,) the reading's force expressed in W with the orientation
+            of S at the last sample, N (negative z = pressing down into the
+            body). Zero before the first sample.
+    State (discrete, updated every ``period_s``): the last ``lag_samples +
+    1`` tared samples, and the reading (wrench_S, force_W) they give.
     """
 
     def __init__(
@@ -123,6 +132,7 @@ class ForceTorqueSensor(LeafSystem):
         self._noise_std = np.broadcast_to(np.asarray(noise_std, float), (6,)).copy()
         self._bias = np.broadcast_to(np.asarray(bias, float), (6,)).copy()
         self._gravity_W = np.asarray(gravity_W, float).reshape(3)
+        self._noisy = bool(np.any(self._noise_std > 0))
         self._n = int(lag_samples) + 1
         self._reaction_port = self.DeclareAbstractInputPort(
             "reaction_forces", AbstractValue.Make([SpatialForce()])
@@ -132,19 +142,11 @@ class ForceTorqueSensor(LeafSystem):
         )
         self._noise_port = self.DeclareVectorInputPort("noise", 6)
         self._buffer = self.DeclareDiscreteState(6 * self._n)
+        self._wrench = self.DeclareDiscreteState(self._bias.copy())
+        self._force = self.DeclareDiscreteState(3)
         self.DeclarePeriodicDiscreteUpdateEvent(period_s, 0.0, self._update)
-        self._wrench_port = self.DeclareVectorOutputPort(
-            "wrench_S",
-            6,
-            self._calc_wrench,
-            prerequisites_of_calc={self.xd_ticket()},
-        )
-        self._force_port = self.DeclareVectorOutputPort(
-            "force_W",
-            3,
-            self._calc_force,
-            prerequisites_of_calc={self.xd_ticket(), self._poses_port.ticket()},
-        )
+        self._wrench_port = self.DeclareStateOutputPort("wrench_S", self._wrench)
+        self._force_port = self.DeclareStateOutputPort("force_W", self._force)
 
     def get_reaction_forces_input_port(self):
         return self._reaction_port
@@ -177,19 +179,23 @@ class ForceTorqueSensor(LeafSystem):
         )
 
     def _update(self, context, discrete_state):
-        sample = self.tared_wrench(context)
-        if self._noise_port.HasValue(context) and np.any(self._noise_std > 0):
+        R_WS = self._R_WS(context)
+        F_S = self._reaction_port.Eval(context)[self._joint].get_coeffs()
+        sample = tared_sensor_wrench(
+            F_S,
+            R_WS,
+            distal_mass_kg=self._distal_mass,
+            p_SScm=self._p_SScm,
+            gravity_W=self._gravity_W,
+        )
+        if self._noisy and self._noise_port.HasValue(context):
             sample = sample + self._noise_std * self._noise_port.Eval(context)
-        old = context.get_discrete_state(self._buffer).get_value()
-        new = np.concatenate([sample, old[: 6 * (self._n - 1)]])
-        discrete_state.set_value(self._buffer, new)
-
-    def _reading(self, context) -> np.ndarray:
-        buf = context.get_discrete_state(self._buffer).get_value()
-        return buf[6 * (self._n - 1) :] + self._bias
-
-    def _calc_wrench(self, context, output: BasicVector):
-        output.SetFromVector(self._reading(context))
-
-    def _calc_force(self, context, output: BasicVector):
-        output.SetFromVector(self._R_WS(context) @ self._reading(context)[3:])
+        if self._n > 1:
+            old = context.get_discrete_state(self._buffer).get_value()
+            buffer = np.concatenate([sample, old[: 6 * (self._n - 1)]])
+        else:
+            buffer = sample
+        discrete_state.set_value(self._buffer, buffer)
+        reading = buffer[6 * (self._n - 1) :] + self._bias
+        discrete_state.set_value(self._wrench, reading)
+        discrete_state.set_value(self._force, R_WS @ reading[3:])

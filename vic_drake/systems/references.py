@@ -1,10 +1,14 @@
 """ForceReferenceSystem: contact, penetration rate and force references.
 
 A thin LeafSystem over :mod:`vic_drake.control.references`. The references
-are cheap algebra on the current measurement, so they are computed in an
-output cache entry (direct feedthrough, as the real controller computed
-them from the same sample as its QP); only the surface-velocity filter has
-state, advanced by a periodic discrete update at the controller rate.
+are cheap algebra on the current measurement, so they are computed in a
+cache entry with direct feedthrough (the "references" and "target_force"
+ports: the real controller computed them from the same sample as its QP,
+and the QP and FDCC read them within the same tick). The periodic discrete
+update at the controller rate advances the surface-velocity filter and
+stores the tick's values, which the "force_reference", "force_min" and
+"contact" ports publish from state: what the QP used at the last tick
+(loggers read them after the tick's update without recomputing).
 """
 
 from __future__ import annotations
@@ -38,17 +42,19 @@ class ForceReferenceSystem(LeafSystem):
         ee_velocity (3): v_WP, m/s.
         measured_force (3): F/T force in W, N, sensor convention.
 
-    Output ports:
+    Output ports (direct feedthrough of the current inputs):
+        target_force (3): force the FDCC stage tracks, N (CF only).
+        references (13): [F_ref (3), F_min (3), target force (3), contact
+            (4)] (see below), read by StiffnessQpSystem in one port
+            evaluation.
+    Output ports (state: the values of the last tick):
         force_reference (3): F_ref, N (sensor convention).
         force_min (3): F_min, N.
-        target_force (3): force the FDCC stage tracks, N (CF only).
         contact (4): [in_contact (0/1), penetration_m, fault (0/1),
             surface_velocity_m_per_s].
-        references (13): all of the above in that order (force_reference,
-            force_min, target_force, contact), read by StiffnessQpSystem in
-            one port evaluation.
 
-    State: the surface-velocity filter (discrete, updated every period).
+    State: the surface-velocity filter and the last tick's F_ref, F_min,
+    contact (discrete, updated every period).
     A non-finite input gives F_ref = 0, F_min = (F_min,x, F_min,y,
     -F_max,z), target 0, in_contact 0 and fault 1 (never a NaN output).
     """
@@ -79,19 +85,21 @@ class ForceReferenceSystem(LeafSystem):
             {self.all_input_ports_ticket(), self.xd_ticket()},
         )
         self._outputs = {}
-        for name, size, start in (
-            ("force_reference", 3, 0),
-            ("force_min", 3, 3),
-            ("target_force", 3, 6),
-            ("contact", 4, 9),
-            ("references", 13, 0),
-        ):
+        for name, size, start in (("target_force", 3, 6), ("references", 13, 0)):
             self._outputs[name] = self.DeclareVectorOutputPort(
                 name,
                 size,
                 self._make_output(start, size),
                 {self._cache.ticket()},
             )
+        self._last = {}
+        for name, size, start in (
+            ("force_reference", 3, 0),
+            ("force_min", 3, 3),
+            ("contact", 4, 9),
+        ):
+            self._last[name] = (self.DeclareDiscreteState(size), start, size)
+            self._outputs[name] = self.DeclareStateOutputPort(name, self._last[name][0])
 
     def _make_output(self, start: int, size: int):
         def calc(context, output: BasicVector):
@@ -150,8 +158,10 @@ class ForceReferenceSystem(LeafSystem):
         value.set_value(self._evaluate(context))
 
     def _update(self, context, discrete_state):
-        _, new_filt = self._cache.Eval(context)
+        values, new_filt = self._cache.Eval(context)
         discrete_state.get_mutable_vector(self._filter_index).SetFromVector(new_filt)
+        for index, start, size in self._last.values():
+            discrete_state.set_value(index, values[start : start + size])
 
     def get_ee_position_input_port(self):
         return self._position_port

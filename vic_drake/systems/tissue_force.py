@@ -100,6 +100,7 @@ class _Cached:
     contact: TipContact
     p_WT: np.ndarray
     p_WPh: np.ndarray
+    v_WT: np.ndarray
 
 
 def tip_contact(
@@ -203,6 +204,9 @@ class TissueForceElement(LeafSystem):
             else 0).
         penetration: (1,) eps, m.
         surface_z: (1,) tissue surface height under the tip in W, m.
+        tip_position: (3,) p_WT, m, and tip_velocity: (3,) v_WT, m/s (the
+            probe tip's kinematics, computed here anyway: the station
+            exports them as ``probe.position`` and ``probe.velocity``).
 
     Outputs depend on the plant's state only (no direct feedthrough from
     the applied-force input), so the loop through the plant is not algebraic.
@@ -256,7 +260,12 @@ class TissueForceElement(LeafSystem):
             "body_spatial_velocities", AbstractValue.Make([SpatialVelocity()])
         )
         model_value = AbstractValue.Make(
-            _Cached(TipContact(0.0, 0.0, 0.0, 0.0, 0.0, 0.0), np.zeros(3), np.zeros(3))
+            _Cached(
+                TipContact(0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+                np.zeros(3),
+                np.zeros(3),
+                np.zeros(3),
+            )
         )
         self._contact_cache = self.DeclareCacheEntry(
             description="tip_contact",
@@ -290,6 +299,19 @@ class TissueForceElement(LeafSystem):
             prerequisites_of_calc={self._contact_cache.ticket()},
         )
 
+        self._tip_position_port = self.DeclareVectorOutputPort(
+            "tip_position",
+            3,
+            lambda c, out: out.SetFromVector(self._contact_cache.Eval(c).p_WT),
+            prerequisites_of_calc={self._contact_cache.ticket()},
+        )
+        self._tip_velocity_port = self.DeclareVectorOutputPort(
+            "tip_velocity",
+            3,
+            lambda c, out: out.SetFromVector(self._contact_cache.Eval(c).v_WT),
+            prerequisites_of_calc={self._contact_cache.ticket()},
+        )
+
     def get_body_poses_input_port(self):
         return self._poses_port
 
@@ -307,6 +329,12 @@ class TissueForceElement(LeafSystem):
 
     def get_surface_z_output_port(self):
         return self._surface_port
+
+    def get_tip_position_output_port(self):
+        return self._tip_position_port
+
+    def get_tip_velocity_output_port(self):
+        return self._tip_velocity_port
 
     def tip_position(self, context) -> np.ndarray:
         """p_WT, m, from the body poses input."""
@@ -335,7 +363,7 @@ class TissueForceElement(LeafSystem):
             slip_speed_m_per_s=self._slip,
             along_normal=self._along_normal,
         )
-        value.set_value(_Cached(contact, p_WT, p_WPh))
+        value.set_value(_Cached(contact, p_WT, p_WPh, v_WT))
 
     def _calc_force(self, context, output):
         output.SetFromVector(self._contact(context).force_W)
