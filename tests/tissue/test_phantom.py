@@ -95,3 +95,19 @@ def test_measured_map(data_dir):
     assert p.surface_z(p.x_m[5], p.y_m[7]) == pytest.approx(p.surface_m[5, 7])
     assert p.surface_m[5, 7] - 0.0025 == pytest.approx(
         np.loadtxt(data_dir / "phantom_map" / "z.txt")[5 * 103 + 7])
+
+
+def test_point_lookup_cached_per_phantom_and_mode():
+    import copy
+
+    p = _plane_phantom()
+    fast = p.point_lookup()
+    assert p.point_lookup() is fast
+    assert fast(0.0437, 0.0213) == pytest.approx(tuple(
+        float(v) for v in vars(p.sample(0.0437, 0.0213)).values()))
+    # A copy switched to nearest lookup must not reuse the bilinear lookup.
+    q = copy.copy(p)
+    q.lookup = "nearest"
+    assert q.point_lookup() is not fast
+    assert q.point_lookup()(0.0437, 0.0213)[3] == pytest.approx(1000 + 1e4 * 0.04)
+    assert p.point_lookup() is fast

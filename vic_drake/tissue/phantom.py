@@ -88,8 +88,14 @@ class Phantom(ABC):
         See :class:`PointLookup`: exact for a GridPhantom, a bilinear
         rasterization at ``resolution_m`` for any other phantom.
         """
-        cache = self.__dict__.setdefault("_point_lookups", {})
-        key = None if isinstance(self, GridPhantom) else float(resolution_m)
+        cache = self.__dict__.get("_point_lookups")
+        if cache is None or cache["owner"] != id(self):
+            # First call, or a (shallow) copy of another phantom: own cache.
+            cache = self.__dict__["_point_lookups"] = {"owner": id(self)}
+        if isinstance(self, GridPhantom):
+            key = ("grid", self.lookup)
+        else:
+            key = ("raster", float(resolution_m))
         if key not in cache:
             cache[key] = PointLookup(self, resolution_m=resolution_m)
         return cache[key]
