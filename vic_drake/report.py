@@ -228,7 +228,8 @@ def render_report(content: ReportContent) -> str:
     if content.stages:
         parts.append("<h2>Stages</h2>")
         rows = [
-            [s.get("name"), "ok" if s.get("ok") else "FAILED", s.get("wall_s"),
+            [s.get("name"), s.get("status") or ("ok" if s.get("ok") else "failed"),
+             s.get("wall_s"),
              s.get("error") or ""]
             for s in content.stages
         ]

@@ -130,10 +130,15 @@ class StageRecord:
     ok: bool
     wall_s: float
     error: str | None = None
+    skipped: bool = False  # Not run here by design (no data, quick mode).
+
+    @property
+    def status(self) -> str:
+        return "ok" if self.ok else ("skipped" if self.skipped else "failed")
 
     def as_dict(self) -> dict:
-        return {"name": self.name, "ok": self.ok, "wall_s": round(self.wall_s, 2),
-                "error": self.error}
+        return {"name": self.name, "ok": self.ok, "status": self.status,
+                "wall_s": round(self.wall_s, 2), "error": self.error}
 
 
 @dataclass
@@ -1058,7 +1063,8 @@ def run_pipeline(ctx: RunContext) -> None:
             rec = StageRecord(name, True, time.perf_counter() - t0)
             ctx.progress(f"[{i + 1}/{len(names)}] {name} done in {rec.wall_s:.1f} s")
         except StageSkipped as exc:
-            rec = StageRecord(name, False, time.perf_counter() - t0, f"skipped: {exc}")
+            rec = StageRecord(name, False, time.perf_counter() - t0, f"skipped: {exc}",
+                              skipped=True)
             ctx.progress(f"[{i + 1}/{len(names)}] {name} skipped: {exc}")
         except Exception as exc:  # noqa: BLE001 - a failed stage is reported, not fatal
             msg = f"{type(exc).__name__}: {exc}"
