@@ -172,7 +172,11 @@ def MakeScanDiagram(scenario: Scenario, *, phantom=None, meshcat=None, data_dir=
         {group name: VectorLogSink} of :data:`LOG_GROUPS`.
     """
     from pydrake.systems.framework import DiagramBuilder
-    from pydrake.systems.primitives import Demultiplexer, LogVectorOutput
+    from pydrake.systems.primitives import (
+        ConstantVectorSource,
+        Demultiplexer,
+        LogVectorOutput,
+    )
 
     from vic_drake.station import MakeStation
     from vic_drake.systems.controller import MakeVariableImpedanceController
@@ -204,8 +208,13 @@ def MakeScanDiagram(scenario: Scenario, *, phantom=None, meshcat=None, data_dir=
     target = builder.AddNamedSystem(
         "target", TargetTrajectorySource(scenario.trajectory)
     )
+    # A nominal run's phantom stays put: a constant (C++) source, evaluated
+    # for free every tick.
     lift = builder.AddNamedSystem(
-        "phantom_lift", PhantomLiftSource(scenario.disturbance)
+        "phantom_lift",
+        ConstantVectorSource([0.0])
+        if scenario.disturbance.is_nominal
+        else PhantomLiftSource(scenario.disturbance),
     )
     demux = builder.AddNamedSystem("ur3e_state_demux", Demultiplexer([6, 6]))
 
@@ -246,9 +255,7 @@ def MakeScanDiagram(scenario: Scenario, *, phantom=None, meshcat=None, data_dir=
         fdcc.GetOutputPort("position_command"),
         station.GetInputPort("ur3e.position_command"),
     )
-    builder.Connect(
-        lift.get_phantom_lift_output_port(), station.GetInputPort("phantom.lift")
-    )
+    builder.Connect(lift.get_output_port(), station.GetInputPort("phantom.lift"))
 
     sources = {
         "station": station,

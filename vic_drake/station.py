@@ -100,10 +100,12 @@ from pydrake.multibody.tree import (
 )
 from pydrake.solvers import Solve
 from pydrake.systems.controllers import InverseDynamics
-from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem
+from pydrake.systems.framework import Diagram, DiagramBuilder
 from pydrake.systems.primitives import (
     Demultiplexer,
+    LinearSystem,
     MatrixGain,
+    Multiplexer,
     RandomSource,
     StateInterpolatorWithDiscreteDerivative,
 )
@@ -596,13 +598,16 @@ def joint_filter_step(q_filtered, q_command, period_s: float, time_constant_s: f
     return q_next, (q_next - q_filtered) / period_s
 
 
-class JointCommandFilter(LeafSystem):
-    """The arm's position servo front end: command -> desired state of the PD.
+def joint_servo_system_matrices(
+    n: int, period_s: float, time_constant_s: float, integral_time_s: float = 0.0
+):
+    """The arm's position servo front end as a discrete linear system.
 
     Models what the UR controller does with streamed position commands:
 
-    - a discrete first-order filter (period ``period_s``, time constant
-      ``time_constant_s``), as the servoj lookahead smooths the stream;
+    - a discrete first-order filter (:func:`joint_filter_step`: period
+      ``period_s``, time constant ``time_constant_s``), as the servoj
+      lookahead smooths the stream;
     - integral action on the tracking error (time constant
       ``integral_time_s``; 0 disables it): the desired position is the
       filtered command plus the integral of (filtered command - measured
@@ -610,62 +615,41 @@ class JointCommandFilter(LeafSystem):
       steady position error -- the real arm holds its pose under 10 N to a
       fraction of a millimetre.
 
-    Input ports ``command`` (n) and ``measured_position`` (n); output
-    ``desired_state`` (2n: desired q, desired velocity) for the plant's PD
-    actuators. State: filtered q, its rate, integral term. Use
-    :meth:`set_state` when starting elsewhere than ``initial_q``.
+    Both are linear, so the station runs them as Drake's ``LinearSystem``
+    (C++, no Python per tick). State ``x = [q_f, v, I]`` (3n: filtered
+    command, its rate over the last period, integral term), input
+    ``u = [command; measured]`` (2n), output ``y = [q_f + I; v]`` (2n, the
+    desired state of the PD actuators, from the state only)::
+
+        q_f+ = q_f + a (command - q_f),   a = 1 - exp(-period / tau)
+        v+   = a (command - q_f) / period
+        I+   = I + (period / T_i) (q_f - measured)
+
+    Returns:
+        (A (3n, 3n), B (3n, 2n), C (2n, 3n), D (2n, 2n)).
     """
+    n = int(n)
+    alpha = 1.0 - np.exp(-period_s / time_constant_s)
+    k_i = period_s / integral_time_s if integral_time_s > 0 else 0.0
+    eye, zero = np.eye(n), np.zeros((n, n))
+    A = np.block(
+        [
+            [(1.0 - alpha) * eye, zero, zero],
+            [-(alpha / period_s) * eye, zero, zero],
+            [k_i * eye, zero, eye],
+        ]
+    )
+    B = np.block(
+        [[alpha * eye, zero], [(alpha / period_s) * eye, zero], [zero, -k_i * eye]]
+    )
+    C = np.block([[eye, zero, eye], [zero, eye, zero]])
+    return A, B, C, np.zeros((2 * n, 2 * n))
 
-    def __init__(
-        self,
-        n: int,
-        period_s: float,
-        time_constant_s: float,
-        initial_q,
-        integral_time_s: float = 0.0,
-    ):
-        super().__init__()
-        self._n, self._period, self._tau = (
-            int(n),
-            float(period_s),
-            float(time_constant_s),
-        )
-        self._ti = float(integral_time_s)
-        self._in = self.DeclareVectorInputPort("command", self._n)
-        self._measured = self.DeclareVectorInputPort("measured_position", self._n)
-        q0 = np.asarray(initial_q, float).reshape(self._n)
-        self._state = self.DeclareDiscreteState(
-            np.concatenate([q0, np.zeros(2 * self._n)])
-        )
-        self.DeclarePeriodicDiscreteUpdateEvent(self._period, 0.0, self._update)
-        self.DeclareVectorOutputPort(
-            "desired_state",
-            2 * self._n,
-            self._calc_desired,
-            prerequisites_of_calc={self.xd_ticket()},
-        )
 
-    def set_state(self, context, q) -> None:
-        """Sets the filter at rest at q (n,), with no integral term."""
-        context.SetDiscreteState(
-            self._state, np.concatenate([np.asarray(q, float), np.zeros(2 * self._n)])
-        )
-
-    def _update(self, context, discrete_state):
-        n = self._n
-        x = context.get_discrete_state(self._state).get_value()
-        q_f, integral = x[:n], x[2 * n :]
-        if self._ti > 0:
-            integral = integral + (self._period / self._ti) * (
-                q_f - self._measured.Eval(context)
-            )
-        q, v = joint_filter_step(q_f, self._in.Eval(context), self._period, self._tau)
-        discrete_state.set_value(self._state, np.concatenate([q, v, integral]))
-
-    def _calc_desired(self, context, output):
-        n = self._n
-        x = context.get_discrete_state(self._state).get_value()
-        output.SetFromVector(np.concatenate([x[:n] + x[2 * n :], x[n : 2 * n]]))
+def joint_servo_rest_state(q) -> np.ndarray:
+    """State of the servo front end at rest at q (n,): ``[q, 0, 0]``."""
+    q = np.asarray(q, float)
+    return np.concatenate([q, np.zeros(2 * len(q))])
 
 
 def _set_pd_gains(plant, joint_names, model, kp, kd):
@@ -845,24 +829,27 @@ def MakeStation(
     # desired state of the PD actuators.
     q_default = plant.GetDefaultPositions(ur3e)
     ur_measured = builder.AddNamedSystem("ur3e_state_demux", Demultiplexer([6, 6]))
+    servo_inputs = builder.AddNamedSystem("ur3e_servo_inputs", Multiplexer([6, 6]))
     ur_filter = builder.AddNamedSystem(
         "ur3e_servo_filter",
-        JointCommandFilter(
-            6,
+        LinearSystem(
+            *joint_servo_system_matrices(
+                6,
+                params.command_period_s,
+                params.servo_time_constant_s,
+                params.servo_integral_time_s,
+            ),
             params.command_period_s,
-            params.servo_time_constant_s,
-            q_default,
-            params.servo_integral_time_s,
         ),
     )
+    ur_filter.configure_default_state(joint_servo_rest_state(q_default))
     builder.Connect(plant.get_state_output_port(ur3e), ur_measured.get_input_port())
-    builder.Connect(
-        ur_measured.get_output_port(0), ur_filter.GetInputPort("measured_position")
-    )
+    builder.Connect(ur_measured.get_output_port(0), servo_inputs.get_input_port(1))
+    builder.Connect(servo_inputs.get_output_port(), ur_filter.get_input_port())
     builder.Connect(
         ur_filter.get_output_port(), plant.get_desired_state_input_port(ur3e)
     )
-    builder.ExportInput(ur_filter.GetInputPort("command"), "ur3e.position_command")
+    builder.ExportInput(servo_inputs.get_input_port(0), "ur3e.position_command")
     lift_interp = builder.AddNamedSystem(
         "phantom_lift_interpolator",
         StateInterpolatorWithDiscreteDerivative(1, params.command_period_s, True),
@@ -1004,7 +991,9 @@ def set_station_state(
     plant.SetPositions(plant_context, ur3e, np.asarray(q, float))
     plant.SetVelocities(plant_context, ur3e, np.zeros(6))
     servo = station.GetSubsystemByName("ur3e_servo_filter")
-    servo.set_state(station.GetMutableSubsystemContext(servo, station_context), q)
+    station.GetMutableSubsystemContext(servo, station_context).SetDiscreteState(
+        joint_servo_rest_state(q)
+    )
     phantom = plant.GetModelInstanceByName("phantom")
     plant.SetPositions(plant_context, phantom, [phantom_lift_m])
     plant.SetVelocities(plant_context, phantom, [0.0])
@@ -1021,6 +1010,9 @@ __all__ = [
     "MakeUr3ePlant",
     "StationParams",
     "initial_q_for_tip",
+    "joint_filter_step",
+    "joint_servo_rest_state",
+    "joint_servo_system_matrices",
     "probe_down_rotation",
     "probe_pose",
     "set_station_state",

@@ -86,3 +86,36 @@ def test_bad_settings_are_rejected():
         _sensor(lag_samples=-1)
     with pytest.raises(VicDrakeError, match="period_s"):
         _sensor(period_s=0.0)
+
+
+def test_one_sample_equals_the_pure_tare_in_any_orientation():
+    """The system's tare (a precomputed matrix) against tared_sensor_wrench."""
+    m, p_com = 0.12, np.array([0.003, 0.01, 0.02])
+    system = ForceTorqueSensor(
+        weld_joint_index=JointIndex(0),
+        child_body_index=BodyIndex(1),
+        X_CS=RigidTransform(RotationMatrix.MakeZRotation(0.4)),
+        distal_mass_kg=m,
+        p_SScm=p_com,
+    )
+    context = system.CreateDefaultContext()
+    F_S = np.array([0.01, -0.02, 0.03, 1.0, -2.0, 3.0])
+    for rpy in [(0, 0, 0), (np.pi, 0, 0), (0.3, -0.7, 1.1)]:
+        R_WC = RotationMatrix(RollPitchYaw(rpy))
+        system.get_reaction_forces_input_port().FixValue(
+            context, [SpatialForce(F_S[:3], F_S[3:])]
+        )
+        system.get_body_poses_input_port().FixValue(
+            context, [RigidTransform(), RigidTransform(R_WC, [0, 0, 0])]
+        )
+        context.SetDiscreteState(system.EvalUniquePeriodicDiscreteUpdate(context))
+        R_WS = (R_WC @ RotationMatrix.MakeZRotation(0.4)).matrix()
+        expected = tared_sensor_wrench(F_S, R_WS, distal_mass_kg=m, p_SScm=p_com)
+        np.testing.assert_allclose(
+            system.get_wrench_output_port().Eval(context), expected, atol=1e-14
+        )
+        np.testing.assert_allclose(
+            system.get_force_output_port().Eval(context),
+            R_WS @ expected[3:],
+            atol=1e-14,
+        )

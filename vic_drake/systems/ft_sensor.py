@@ -133,6 +133,12 @@ class ForceTorqueSensor(LeafSystem):
         self._bias = np.broadcast_to(np.asarray(bias, float), (6,)).copy()
         self._gravity_W = np.asarray(gravity_W, float).reshape(3)
         self._noisy = bool(np.any(self._noise_std > 0))
+        # tared_sensor_wrench as a matrix on gravity in S (computed once):
+        # static load [p x f; f] with f = -m g_S.
+        px, py, pz = self._p_SScm
+        skew = np.array([[0.0, -pz, py], [pz, 0.0, -px], [-py, px, 0.0]])
+        self._static_per_g = -self._distal_mass * np.vstack([skew, np.eye(3)])
+        self._identity_CS = bool(np.array_equal(self._R_CS, np.eye(3)))
         self._n = int(lag_samples) + 1
         self._reaction_port = self.DeclareAbstractInputPort(
             "reaction_forces", AbstractValue.Make([SpatialForce()])
@@ -179,15 +185,11 @@ class ForceTorqueSensor(LeafSystem):
         )
 
     def _update(self, context, discrete_state):
-        R_WS = self._R_WS(context)
+        R_WC = self._poses_port.Eval(context)[self._child].rotation().matrix()
+        R_WS = R_WC if self._identity_CS else R_WC @ self._R_CS
         F_S = self._reaction_port.Eval(context)[self._joint].get_coeffs()
-        sample = tared_sensor_wrench(
-            F_S,
-            R_WS,
-            distal_mass_kg=self._distal_mass,
-            p_SScm=self._p_SScm,
-            gravity_W=self._gravity_W,
-        )
+        # = tared_sensor_wrench(F_S, R_WS, ...), one product per tick.
+        sample = F_S - self._static_per_g @ (R_WS.T @ self._gravity_W)
         if self._noisy and self._noise_port.HasValue(context):
             sample = sample + self._noise_std * self._noise_port.Eval(context)
         if self._n > 1:

@@ -101,6 +101,7 @@ class _Cached:
     p_WT: np.ndarray
     p_WPh: np.ndarray
     v_WT: np.ndarray
+    f_W: np.ndarray  # contact.force_W
 
 
 def tip_contact(
@@ -252,6 +253,10 @@ class TissueForceElement(LeafSystem):
         self._phantom = phantom.point_lookup(resolution_m=lookup_resolution_m)
         self._indenter = indenter_body_index
         self._phantom_body = phantom_body_index
+        self._i_indenter, self._i_phantom = (
+            int(indenter_body_index),
+            int(phantom_body_index),
+        )
         self._p_BT = np.asarray(p_BT, float).reshape(3)
         self._poses_port = self.DeclareAbstractInputPort(
             "body_poses", AbstractValue.Make([RigidTransform()])
@@ -262,6 +267,7 @@ class TissueForceElement(LeafSystem):
         model_value = AbstractValue.Make(
             _Cached(
                 TipContact(0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+                np.zeros(3),
                 np.zeros(3),
                 np.zeros(3),
                 np.zeros(3),
@@ -346,13 +352,13 @@ class TissueForceElement(LeafSystem):
     def _calc_contact(self, context, value):
         poses = self._poses_port.Eval(context)
         velocities = self._velocities_port.Eval(context)
-        X_WB = poses[int(self._indenter)]
-        V_WB = velocities[int(self._indenter)]
+        X_WB = poses[self._i_indenter]
+        V_WB = velocities[self._i_indenter]
         p_BT_W = X_WB.rotation() @ self._p_BT
         p_WT = X_WB.translation() + p_BT_W
         v_WT = V_WB.translational() + _cross(V_WB.rotational(), p_BT_W)
-        p_WPh = poses[int(self._phantom_body)].translation()
-        V_WPh = velocities[int(self._phantom_body)]
+        p_WPh = poses[self._i_phantom].translation()
+        V_WPh = velocities[self._i_phantom]
         contact = tip_contact(
             self._phantom,
             p_WT,
@@ -363,14 +369,14 @@ class TissueForceElement(LeafSystem):
             slip_speed_m_per_s=self._slip,
             along_normal=self._along_normal,
         )
-        value.set_value(_Cached(contact, p_WT, p_WPh, v_WT))
+        value.set_value(_Cached(contact, p_WT, p_WPh, v_WT, contact.force_W))
 
     def _calc_force(self, context, output):
-        output.SetFromVector(self._contact(context).force_W)
+        output.SetFromVector(self._contact_cache.Eval(context).f_W)
 
     def _calc_spatial_forces(self, context, output):
         cached = self._contact_cache.Eval(context)
-        f_W = cached.contact.force_W
+        f_W = cached.f_W
         on_tip = ExternallyAppliedSpatialForce()
         on_tip.body_index = self._indenter
         on_tip.p_BoBq_B = self._p_BT
