@@ -86,6 +86,23 @@ def test_system_applies_force_at_tip_and_reaction_on_phantom():
     np.testing.assert_allclose(on_tip.F_Bq_W.translational(), [0, 0, expected])
     np.testing.assert_allclose(on_phantom.F_Bq_W.translational(), [0, 0, -expected])
     np.testing.assert_allclose(on_phantom.p_BoBq_B, [0.01, 0.02, 0.09])
+    # The tip's kinematics, exported by the station as probe.position/velocity.
+    np.testing.assert_allclose(
+        system.get_tip_position_output_port().Eval(context), [0.01, 0.02, 0.09]
+    )
+    np.testing.assert_allclose(
+        system.get_tip_velocity_output_port().Eval(context), [0, 0, 0]
+    )
+    # A second context (2 mm deeper) does not alter the first one's forces.
+    other = system.CreateDefaultContext()
+    deeper = RigidTransform(X_WB.rotation(), X_WB.translation() - [0, 0, 0.002])
+    system.get_body_poses_input_port().FixValue(other, [poses[0], deeper, poses[2]])
+    system.get_body_spatial_velocities_input_port().FixValue(other, vels)
+    second = system.get_spatial_forces_output_port().Eval(other)
+    assert second[0].F_Bq_W.translational()[2] > expected
+    again = system.get_spatial_forces_output_port().Eval(context)
+    np.testing.assert_allclose(again[0].F_Bq_W.translational(), [0, 0, expected])
+    np.testing.assert_allclose(on_tip.F_Bq_W.translational(), [0, 0, expected])
 
 
 def test_grid_lookup_equals_the_grid_phantom():

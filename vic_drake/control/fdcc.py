@@ -197,6 +197,8 @@ class FdccModel:
         self.ur3e = ur3e
         self.frame = ee.body_frame()
         self._context = context
+        self._world = plant.world_frame()
+        self._p_origin = np.zeros(3)
         self.q_lower = plant.GetPositionLowerLimits()
         self.q_upper = plant.GetPositionUpperLimits()
 
@@ -217,9 +219,9 @@ class FdccModel:
             self._context,
             JacobianWrtVariable.kV,
             self.frame,
-            np.zeros(3),
-            self.plant.world_frame(),
-            self.plant.world_frame(),
+            self._p_origin,
+            self._world,
+            self._world,
         )
         return self.frame.CalcPoseInWorld(self._context), H, J
 

@@ -253,6 +253,13 @@ class TissueForceElement(LeafSystem):
         self._phantom = phantom.point_lookup(resolution_m=lookup_resolution_m)
         self._indenter = indenter_body_index
         self._phantom_body = phantom_body_index
+        on_tip = ExternallyAppliedSpatialForce()
+        on_tip.body_index = indenter_body_index
+        on_tip.p_BoBq_B = np.asarray(p_BT, float).reshape(3)
+        on_phantom = ExternallyAppliedSpatialForce()
+        on_phantom.body_index = phantom_body_index
+        self._applied = [on_tip, on_phantom]
+        self._zero_torque = np.zeros(3)
         self._i_indenter, self._i_phantom = (
             int(indenter_body_index),
             int(phantom_body_index),
@@ -377,14 +384,12 @@ class TissueForceElement(LeafSystem):
     def _calc_spatial_forces(self, context, output):
         cached = self._contact_cache.Eval(context)
         f_W = cached.f_W
-        on_tip = ExternallyAppliedSpatialForce()
-        on_tip.body_index = self._indenter
-        on_tip.p_BoBq_B = self._p_BT
-        on_tip.F_Bq_W = SpatialForce(np.zeros(3), f_W)
+        # set_value copies the list into the port's value, so the two force
+        # records are kept and refilled (this runs every plant step).
+        on_tip, on_phantom = self._applied
+        on_tip.F_Bq_W = SpatialForce(self._zero_torque, f_W)
         # The reaction acts on the phantom (which only translates) at the
         # same world point.
-        on_phantom = ExternallyAppliedSpatialForce()
-        on_phantom.body_index = self._phantom_body
         on_phantom.p_BoBq_B = cached.p_WT - cached.p_WPh
-        on_phantom.F_Bq_W = SpatialForce(np.zeros(3), -f_W)
-        output.set_value([on_tip, on_phantom])
+        on_phantom.F_Bq_W = SpatialForce(self._zero_torque, -f_W)
+        output.set_value(self._applied)
