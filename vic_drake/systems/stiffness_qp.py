@@ -14,7 +14,7 @@ import copy
 import math
 
 import numpy as np
-from pydrake.systems.framework import BasicVector, LeafSystem
+from pydrake.systems.framework import LeafSystem
 
 from vic_drake.control.params import ControllerParams
 from vic_drake.control.references import constant_stiffness
@@ -52,8 +52,8 @@ class StiffnessQpSystem(LeafSystem):
         status (6): [qp_ok, fallback_count, fault, in_contact,
             solve_time_s, penetration_m].
 
-    State (discrete): commit (14) and status (6). K starts at K_min
-    (constant stiffness for CS/CF).
+    State (discrete): commit (14), status (6), K (3) and D (3), all
+    published as they are. K starts at K_min (constant stiffness for CS/CF).
 
     Fallbacks: a failed or infeasible solve, or a non-finite input (fault),
     gives K = K_min, qp_ok = 0 and increments fallback_count. With the tank
@@ -95,24 +95,17 @@ class StiffnessQpSystem(LeafSystem):
         self._status_index = self.DeclareDiscreteState(
             np.array([1.0, 0.0, 0.0, 0.0, 0.0, 0.0])
         )
+        # K and D again, each its own group so the ports publish state (no
+        # Python per evaluation).
+        self._stiffness_index = self.DeclareDiscreteState(commit0[6:9])
+        self._damping_index = self.DeclareDiscreteState(commit0[9:12])
         self.DeclarePeriodicDiscreteUpdateEvent(self._dt, 0.0, self._update)
-        self._stiffness_port = self.DeclareVectorOutputPort(
-            "stiffness", 3, self._calc_stiffness, {self.xd_ticket()}
+        self._stiffness_port = self.DeclareStateOutputPort(
+            "stiffness", self._stiffness_index
         )
-        self._damping_port = self.DeclareVectorOutputPort(
-            "damping", 3, self._calc_damping, {self.xd_ticket()}
-        )
+        self._damping_port = self.DeclareStateOutputPort("damping", self._damping_index)
         self._commit_port = self.DeclareStateOutputPort("commit", self._commit_index)
         self._status_port = self.DeclareStateOutputPort("status", self._status_index)
-
-    def _calc_stiffness(self, context, output: BasicVector):
-        output.SetFromVector(
-            context.get_discrete_state(self._commit_index).value()[6:9]
-        )
-
-    def _calc_damping(self, context, output: BasicVector):
-        k = context.get_discrete_state(self._commit_index).value()[6:9]
-        output.SetFromVector(2.0 * self._zeta * np.sqrt(np.maximum(k, 0.0)))
 
     def _update(self, context, discrete_state):
         inp = self._in
@@ -162,6 +155,10 @@ class StiffnessQpSystem(LeafSystem):
                     count += 1.0
         commit = discrete_state.get_mutable_vector(self._commit_index)
         commit.SetFromVector([*e, *e_dot, *k, *d_used, self._dt, active])
+        discrete_state.get_mutable_vector(self._stiffness_index).SetFromVector(k)
+        discrete_state.get_mutable_vector(self._damping_index).SetFromVector(
+            [2.0 * zeta * math.sqrt(max(k_i, 0.0)) for k_i in k]
+        )
         status = discrete_state.get_mutable_vector(self._status_index)
         in_contact = 0.0 if fault else refs[9]
         pen = refs[10] if math.isfinite(refs[10]) else 0.0
