@@ -10,13 +10,15 @@ share of the time spent in each vic_drake system.
     python benchmarks/bench_scan.py [--duration 5] [--scenario diagrams/X.yaml] [--top 25]
         [--qp-solver exact|osqp|clarabel] [--time-step-ms 2] [--no-profile]
 
-Measured (VS-VF nominal, 5 s, 2 cores, other jobs running): RTF 0.82-0.93
-(2.2-2.4 ms per tick) with the 1 ms plant step, the OSQP program and every
-system recomputed for the loggers; RTF 1.9-2.1 (0.93-1.05 ms per tick)
-with the 2 ms plant step, the closed-form QP solver, the F/T reading and
-the tick's references published from state, the probe kinematics from the
-tissue element and the servo front end in C++. ``--qp-solver osqp`` costs
-about 0.1 ms more per tick.
+Measured (VS-VF nominal, 5 s, this 2-core host, interleaved runs; the host
+is shared, figures vary by about 10 %): before, RTF 0.77-0.80 (2.5-2.6 ms
+per tick) with the 1 ms plant step, the OSQP program and the force
+references, sensor force and probe kinematics recomputed for the loggers;
+after, RTF 1.9-2.2 (0.91-1.05 ms per tick) with the 2 ms plant step, the
+closed-form QP solver, the F/T reading, the tick's references and K, D
+published from state, the probe kinematics from the tissue element and the
+servo front end in C++. ``--qp-solver osqp`` costs about 0.25 ms more per
+tick (1.27-1.38 ms).
 """
 
 from __future__ import annotations
