@@ -760,7 +760,8 @@ def MakeStation(
         phantom.lift (1): phantom z offset command, m (servoed stiffly).
     Output ports:
         ur3e.state (12): q (rad), v (rad/s).
-        ft_sensor.force_W (3): tared, noisy, lagged sensor force in W, N
+        ft_sensor.force_W (3): tared, noisy (and, with sensor_lag_samples,
+            delayed) sensor force in W, N
             (negative z = the probe pressing down into the body).
         ft_sensor.wrench_S (6): the same reading ``[tau; f]`` in the sensor
             frame S (N m, N).

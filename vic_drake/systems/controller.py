@@ -50,7 +50,10 @@ def MakeVariableImpedanceController(
         outputs: "stiffness" (3, N/m), "damping" (3, N s/m), "target_force"
         (3, N), "force_reference" (3, N), "force_min" (3, N), "tank" (4:
         T_J, power_W, sigma, enabled), "status" (6: qp_ok, fallback_count,
-        fault, in_contact, solve_time_s, penetration_m).
+        fault, in_contact, solve_time_s, penetration_m). All but
+        "target_force" (direct feedthrough, read by the compliance stage in
+        the same tick) describe the last tick (from state):
+        force_reference and force_min are what that tick's QP used.
     """
     if not isinstance(params, ControllerParams):
         raise VicDrakeError(
