@@ -1,19 +1,26 @@
 """The closed-loop scan diagram: wiring, a short run, and the real-log scenarios."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
 from vic_drake.errors import VicDrakeError
 from vic_drake.experiments import (
+    FZI_DEFAULT_FDCC_Z_GAINS,
     LOG_GROUPS,
+    MODEL_LOOP_GAIN_PER_KP,
+    PAPER_FDCC_Z_GAINS,
     MakeScanDiagram,
+    _with_z_gains,
     detect_controller,
     fit_target_profile,
+    identify_fdcc_z_gains,
     run_scan,
     scenario_from_real_log,
     synthetic_scenario,
 )
-from vic_drake.metrics import CANONICAL_COLUMNS
+from vic_drake.metrics import CANONICAL_COLUMNS, estimate_force_loop_gain
 
 
 def test_scan_diagram_is_wired_and_logs_every_group():
@@ -135,6 +142,45 @@ def test_real_log_scenarios(data_dir):
         scenario_from_real_log(cs, name="mystery_log")
     with pytest.raises(VicDrakeError, match="cs or cf"):
         scenario_from_real_log(cs, name="x", controller="vs-vf")
+
+
+@pytest.mark.parametrize("gains", [FZI_DEFAULT_FDCC_Z_GAINS, PAPER_FDCC_Z_GAINS])
+def test_model_loop_gain_per_kp(gains):
+    """The station's CF force loop gain is MODEL_LOOP_GAIN_PER_KP k_p (the
+    constant the identification of the real logs' gains is scored with)."""
+    s = synthetic_scenario("cf")
+    s = replace(s, fdcc=_with_z_gains(s.fdcc, *gains))
+    df = run_scan(s, duration_s=8.0).df
+    est = estimate_force_loop_gain(df[df["t_s"] > 3.0])
+    assert est["r2"] > 0.6
+    assert est["gain_m_per_s_per_N"] / gains[0] == pytest.approx(
+        MODEL_LOOP_GAIN_PER_KP, rel=0.25
+    )
+
+
+@pytest.mark.realdata
+def test_cs_and_cf_logs_ran_with_the_fzi_default_gains(data_dir):
+    """Every 9-column baseline log's loop gain points at FZI's default z gains
+    (the paper's text gives CF k_p = 0.3; its logs say otherwise)."""
+    from vic_drake.realdata import read_bag
+
+    for name, k_z, f_ref in (
+        ("test_compliance_control400", 400.0, 0.0),
+        ("test_compliance_control400_dist", 400.0, 0.0),
+        ("test_force_control", 0.0, 7.0),
+        ("test_force_control_dist", 0.0, 7.0),
+    ):
+        real = read_bag(data_dir / "experiments" / name)
+        got = identify_fdcc_z_gains(
+            real, stiffness_z_N_per_m=k_z, force_ref_N=f_ref, fallback=PAPER_FDCC_Z_GAINS
+        )
+        assert got["identified"] and got["r2"] > 0.9, name
+        assert got["gain_m_per_s_per_N"] == pytest.approx(2.0e-3, rel=0.1), name
+        assert got["gains"] == FZI_DEFAULT_FDCC_Z_GAINS, name
+        s = scenario_from_real_log(real, name=name)
+        assert (s.fdcc.p_gains[2], s.fdcc.d_gains[2]) == FZI_DEFAULT_FDCC_Z_GAINS
+    s = scenario_from_real_log(real, name=name, fdcc_z_gains=PAPER_FDCC_Z_GAINS)
+    assert s.fdcc.p_gains[2] == PAPER_FDCC_Z_GAINS[0]
 
 
 @pytest.mark.slow

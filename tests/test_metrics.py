@@ -161,3 +161,30 @@ def test_real_logs_convert_to_the_canonical_layout(data_dir):
     assert np.isnan(cs["x_d_m"]).all() and (cs["force_sensor_z_N"] < 0).all()
     with pytest.raises(VicDrakeError, match="layout"):
         real_to_canonical(read_bag(data_dir / "palpation" / "test_soft_1hz"))
+
+
+def test_force_loop_gain_recovers_a_known_integral_loop():
+    """z' = G (K (z_d - z) + f_ref - f) with a Hunt-Crossley-like surface
+    force and a bias: the estimate returns G and the bias."""
+    from vic_drake.metrics import estimate_force_loop_gain
+
+    dt, g, k, bias = 0.002, 2.0e-3, 400.0, 0.3
+    t = np.arange(0.0, 20.0, dt)
+    surface = 0.1 + 0.01 * np.sin(2 * np.pi * 0.1 * t)
+    z_d = np.full_like(t, 0.085)
+    z = np.empty_like(t)
+    z[0] = 0.095
+    force = np.empty_like(t)  # Sensor convention: negative = pressing.
+    for i in range(len(t)):
+        force[i] = -1500.0 * max(surface[i] - z[i], 0.0) ** 1.2 * 10 - bias
+        if i + 1 < len(t):
+            z[i + 1] = z[i] + dt * g * (k * (z_d[i] - z[i]) - (force[i] + bias))
+    df = pd.DataFrame({"t_s": t, "z_m": z, "z_d_m": z_d, "force_sensor_z_N": force})
+    est = estimate_force_loop_gain(df, stiffness_z_N_per_m=k, force_ref_z_N=0.0)
+    assert est["gain_m_per_s_per_N"] == pytest.approx(g, rel=0.02)
+    assert est["offset_N"] == pytest.approx(bias, abs=0.02)
+    assert est["r2"] > 0.99
+    short = estimate_force_loop_gain(df.iloc[:50], stiffness_z_N_per_m=k, force_ref_z_N=0.0)
+    assert np.isnan(short["gain_m_per_s_per_N"])
+    with pytest.raises(VicDrakeError, match="stiffness_z_N_per_m"):
+        estimate_force_loop_gain(df)

@@ -486,6 +486,78 @@ def compare_contact_loss(sim: pd.DataFrame, real: pd.DataFrame) -> dict:
 # Phantom lift of the real disturbance logs.
 
 
+def estimate_force_loop_gain(
+    df: pd.DataFrame,
+    *,
+    stiffness_z_N_per_m: float | None = None,
+    force_ref_z_N: float | None = None,
+    smooth_s: float = 0.1,
+) -> dict:
+    """Identifies the z loop gain of the FDCC layer from a scan, m/s per N.
+
+    FDCC integrates the net Cartesian error: in quasi-steady motion the tip's
+    z velocity is proportional to the net z error,
+    ``z' = G (K_z (z_d - z) + f_ref - f_m)`` (sensor convention, f negative
+    = pressing), with G set by the PD gain k_p, ``error_scale``, the internal
+    model and the arm's position servo. G is the least-squares slope (with an
+    intercept, which absorbs a constant force bias) of the smoothed z velocity
+    against that error over the contact samples. The 9-column logs hold
+    neither K_z nor f_ref: pass the run's constants.
+
+    Args:
+        df: canonical scan frame (t_s, z_m, z_d_m, force_sensor_z_N; and
+            stiffness_z_N_per_m / force_ref_z_N when not given).
+        stiffness_z_N_per_m: constant K_z, N/m (default: the frame's column).
+        force_ref_z_N: constant target force, sensor convention, N (default:
+            the frame's column).
+        smooth_s: Savitzky-Golay window of the velocity, s.
+
+    Returns:
+        dict with ``gain_m_per_s_per_N``, ``r2`` (of the linear model),
+        ``offset_N`` (the constant error the intercept absorbed: the fit is
+        ``z' = G (error - offset)``) and ``samples``; the
+        figures are NaN when fewer than 100 contact samples exist.
+    """
+    from scipy.signal import savgol_filter
+
+    _require(df, "t_s", "z_m", "z_d_m", "force_sensor_z_N")
+    t = df["t_s"].to_numpy(float)
+    z = df["z_m"].to_numpy(float)
+    f = df["force_sensor_z_N"].to_numpy(float)
+    if stiffness_z_N_per_m is None:
+        _require(df, "stiffness_z_N_per_m")
+        k = df["stiffness_z_N_per_m"].to_numpy(float)
+    else:
+        k = np.full(len(df), float(stiffness_z_N_per_m))
+    if force_ref_z_N is None:
+        _require(df, "force_ref_z_N")
+        f_ref = df["force_ref_z_N"].to_numpy(float)
+    else:
+        f_ref = np.full(len(df), float(force_ref_z_N))
+    nan = {"gain_m_per_s_per_N": np.nan, "r2": np.nan, "offset_N": np.nan, "samples": 0}
+    if len(t) < 100:
+        return nan
+    dt = float(np.median(np.diff(t)))
+    window = max(5, int(round(smooth_s / dt)) | 1)
+    vz = np.gradient(savgol_filter(z, window, 3), t)
+    net = k * (df["z_d_m"].to_numpy(float) - z) + f_ref - f
+    use = contact_mask(df) & np.isfinite(net) & np.isfinite(vz)
+    n = int(use.sum())
+    if n < 100 or np.ptp(net[use]) == 0:
+        return {**nan, "samples": n}
+    a = np.column_stack([net[use], np.ones(n)])
+    (gain, intercept), *_ = np.linalg.lstsq(a, vz[use], rcond=None)
+    resid = vz[use] - a @ np.array([gain, intercept])
+    r2 = 1.0 - float(resid.var() / vz[use].var())
+    offset = -intercept / gain if gain != 0 else np.nan
+    return {
+        "gain_m_per_s_per_N": float(gain),
+        "r2": r2,
+        "offset_N": float(offset),
+        "samples": n,
+    }
+
+
 def apparent_surface_z_m(df: pd.DataFrame, phantom) -> np.ndarray:
     """Surface height implied by the tip height and the pressing force, m.
 
@@ -582,6 +654,7 @@ __all__ = [
     "compare_with_real",
     "contact_loss_intervals",
     "contact_mask",
+    "estimate_force_loop_gain",
     "estimate_phantom_lift",
     "estimate_time_offset_s",
     "force_range_N",

@@ -529,32 +529,6 @@ def _plot_maps(tmap, pts, real_map, ribs_sim, ribs_real):
 #: start) and scans QUICK_SCAN_M along -x.
 QUICK_APPROACH_Z_M = 0.11
 QUICK_SCAN_M = 0.05
-#: The disturbance events start this long after the target reaches its
-#: scanning height (quick: the first only; full: both).
-DISTURBANCE_DELAYS_S = (0.5, 8.0)
-
-
-def disturbance_lifts(t_scan_start_s: float, *, events: int = 1):
-    """The phantom lifted by hand, let go and caught again (Fig. 7).
-
-    Each event: the phantom rises 15 mm over 0.5 s and is held 1 s (the probe
-    is pushed away from its target), then drops over 0.2 s to 10 mm BELOW
-    its rest, faster than the compliant probe can follow (contact is lost),
-    stays there 0.8 s and comes back up over 0.5 s (re-contact). The
-    synthetic lifts of ``diagrams/`` rise and fall over about 1 s and the probe
-    follows them without losing contact, so they cannot test C7's "K falls to
-    K_min while contact is lost".
-    """
-    from vic_drake.scenario import PhantomLift
-
-    lifts = []
-    for delay in DISTURBANCE_DELAYS_S[:events]:
-        t = t_scan_start_s + delay
-        lifts.append(PhantomLift(start_s=t, height_m=0.015, rise_s=0.5, hold_s=1.0,
-                                 fall_s=0.2))
-        lifts.append(PhantomLift(start_s=t + 1.7, height_m=-0.010, rise_s=0.2,
-                                 hold_s=0.8, fall_s=0.5))
-    return lifts
 
 
 def scan_scenario(controller: str, *, disturbed: bool, phantom_kind: str, quick: bool):
@@ -562,13 +536,14 @@ def scan_scenario(controller: str, *, disturbed: bool, phantom_kind: str, quick:
 
     :func:`vic_drake.experiments.synthetic_scenario` (the scenarios of
     ``diagrams/``: the real rig's scan and controller settings) on the
-    requested phantom, with :func:`disturbance_lifts` as the disturbance.
+    requested phantom, with :func:`vic_drake.experiments.disturbance_lifts`
+    as the disturbance.
     Quick mode shortens the approach and the scan (QUICK_* constants) and
     has one disturbance event instead of two.
     """
     from dataclasses import replace
 
-    from vic_drake.experiments import synthetic_scenario
+    from vic_drake.experiments import disturbance_lifts, scan_start_s, synthetic_scenario
     from vic_drake.scenario import DisturbanceConfig
 
     base = synthetic_scenario(controller, disturbed=False)
@@ -578,10 +553,8 @@ def scan_scenario(controller: str, *, disturbed: bool, phantom_kind: str, quick:
                        end_x_m=traj.start_x_m - QUICK_SCAN_M)
     disturbance = DisturbanceConfig()
     if disturbed:
-        t_scan = (traj.start_delay_s + (traj.approach_z_m - traj.target_z_m)
-                  / traj.approach_speed_m_per_s + traj.dwell_s)
         disturbance = DisturbanceConfig(
-            lifts=disturbance_lifts(t_scan, events=1 if quick else 2))
+            lifts=disturbance_lifts(scan_start_s(traj), events=1 if quick else 2))
     cond = "disturbance" if disturbed else "nominal"
     return replace(
         base,
@@ -952,7 +925,7 @@ REPORT_NOTES = (
     "real value. The real CF reference (7 N) is not logged; it is taken from the "
     "data's README.",
     "The disturbance here is a scripted lift, drop below rest and return of the phantom "
-    "(vic_drake.reproduce.disturbance_lifts); the paper's was by hand, so peak forces "
+    "(vic_drake.experiments.disturbance_lifts); the paper's was by hand, so peak forces "
     "compare in order, not in value.",
     "Quick mode scans 5 cm instead of 20 cm with one disturbance event; force ranges "
     "(C5) and peak forces (C7) see less of the body than the full run.",
