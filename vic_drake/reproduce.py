@@ -228,41 +228,20 @@ def real_scan_frame(df: pd.DataFrame, *, controller: str | None = None) -> pd.Da
             rig used (not logged); "cs" has no force reference.
 
     Returns:
-        DataFrame with t_s, x_m, y_m, z_m, z_d_m, force_sensor_z_N (sensor
-        sign: negative = pressing) and, for the 31-column layout,
-        force_ref_z_N, force_min_z_N, penetration_m, stiffness_*_N_per_m,
-        tank_energy_J, tank_power_W (tank change / tick period).
+        :func:`vic_drake.metrics.real_to_canonical` without the columns the
+        log does not hold (9-column: pose, z target, sensor z force,
+        contact; 31-column: also the controller's signals).
+
+    Raises:
+        VicDrakeError: a log that is not a scan log.
     """
-    layout = df.attrs.get("layout")
-    if layout == "scan":
-        out = pd.DataFrame({
-            "t_s": df["t_s"], "x_m": df["x_m"], "y_m": df["y_m"], "z_m": df["z_m"],
-            "z_d_m": df["z_target_m"], "force_sensor_z_N": -df["force_pressing_z_N"],
-        })
-        if controller == "cf":
-            out["force_ref_z_N"] = -REAL_CF_REFERENCE_N
-        return out
-    if layout == "controller":
-        dt = np.diff(df["t_s"].to_numpy(), prepend=np.nan)
-        dt[0] = dt[1] if len(dt) > 1 else np.nan
-        return pd.DataFrame({
-            "t_s": df["t_s"], "x_m": df["x_m"], "y_m": df["y_m"], "z_m": df["z_m"],
-            "x_d_m": df["x_d_m"], "y_d_m": df["y_d_m"], "z_d_m": df["z_d_m"],
-            "force_sensor_x_N": df["sensor_force_x_N"],
-            "force_sensor_y_N": df["sensor_force_y_N"],
-            "force_sensor_z_N": df["sensor_force_z_N"],
-            "force_ref_z_N": df["force_ref_z_N"], "force_min_z_N": df["force_min_z_N"],
-            "penetration_m": df["penetration_m"],
-            "stiffness_x_N_per_m": df["stiffness_x_N_per_m"],
-            "stiffness_y_N_per_m": df["stiffness_y_N_per_m"],
-            "stiffness_z_N_per_m": df["stiffness_z_N_per_m"],
-            "tank_energy_J": df["tank_energy_J"],
-            "tank_power_W": df["tank_delta_J"].to_numpy() / np.where(dt > 0, dt, np.nan),
-        })
-    raise VicDrakeError(
-        f"real_scan_frame: log layout {layout!r} is not a scan log; needs 'scan' (9 "
-        "columns) or 'controller' (31 columns)"
-    )
+    from vic_drake.metrics import real_to_canonical
+
+    out = real_to_canonical(df)
+    out = out[[c for c in out.columns if out[c].notna().any()]]
+    if df.attrs.get("layout") == "scan" and controller == "cf":
+        out["force_ref_z_N"] = -REAL_CF_REFERENCE_N
+    return out
 
 
 def stage_real_scans(ctx: RunContext) -> dict:
@@ -543,7 +522,11 @@ def scan_scenario(controller: str, *, disturbed: bool, phantom_kind: str, quick:
     """
     from dataclasses import replace
 
-    from vic_drake.experiments import disturbance_lifts, scan_start_s, synthetic_scenario
+    from vic_drake.experiments import (
+        disturbance_lifts,
+        scan_start_s,
+        synthetic_scenario,
+    )
     from vic_drake.scenario import DisturbanceConfig
 
     base = synthetic_scenario(controller, disturbed=False)

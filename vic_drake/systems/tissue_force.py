@@ -18,23 +18,23 @@ Geometry and signs (all in the world frame W = the rig's ``base_link``):
   only, with velocity v_WP):
   ``eps_dot = s_x (xdot_T - xdot_P) + s_y (ydot_T - ydot_P) + zdot_P - zdot_T``.
 - The force magnitude is ``hunt_crossley_force(eps, eps_dot, kappa, lam,
-  beta, clip_tension=True)`` (zero out of contact, never pulling), applied
-  along +z of W at T on the indenter body; the equal and opposite force acts
-  on the phantom body at the same point. The map's kappa and lambda were
-  fitted to vertical indentations, so by default the force is vertical (the
-  paper's 1-D model). Two options, off by default, add the horizontal
-  forces the real scans show: ``along_normal`` tilts the force along the
-  surface normal, ``F (-dz/dx, -dz/dy, 1)`` (the real logs' lateral sensor
-  forces follow -0.6..-0.8 dz/dx F and +0.7..+1.0 dz/dy F in their frame,
-  see below), and a regularised sliding friction (coefficient mu times the
-  Hunt-Crossley force; the real scans' x force has an offset of about
-  1.4-1.6 N at 7 N pressing while sliding along -x at 1 cm/s: mu ~ 0.2).
+  beta, clip_tension=True)`` (zero out of contact, never pulling): the
+  vertical component of the force on the indenter body at T; the equal and
+  opposite force acts on the phantom body at the same point. The map's kappa
+  and lambda were fitted to vertical indentations, so the law gives the
+  vertical force, as in the paper's 1-D model. Two horizontal terms, on in
+  the station's defaults (``StationParams.tissue_force_along_normal``,
+  ``tissue_friction_coefficient``), add what the real scans' lateral sensor
+  forces show (:func:`vic_drake.metrics.estimate_tissue_friction`): the
+  force tilted along the surface normal, ``F (-dz/dx, -dz/dy, 1)`` (the real
+  logs' lateral forces follow 0.82-1.04 times that tilt), and a regularised
+  sliding friction ``-mu F v_t / sqrt(|v_t|^2 + v_s^2)`` (mu 0.22-0.30 in
+  the real logs). The element's own defaults are the paper's vertical model.
 
-  Note on the real logs' sensor x, y columns: regressed on the map's slope
-  they behave as the external force expressed in the sensor frame S (when
-  the tool points down x_S = x_W, y_S = -y_W, z_S = -z_W), not as minus
-  the external force in W: the two agree in y and z and differ in the sign
-  of x.
+  Note on the real logs' sensor x, y columns: they are the external force in
+  the sensor frame S (tool pointing down: x_S = x_W, y_S = -y_W, z_S =
+  -z_W); :func:`vic_drake.metrics.real_to_canonical` turns them into the
+  canonical reading, minus the external force in W, by negating x.
 """
 
 from __future__ import annotations
