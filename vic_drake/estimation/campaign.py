@@ -339,33 +339,28 @@ def fit_point(
     palpating = aligned.t_s >= record.t_contact_s
     segment = aligned.select(palpating)
     surface = z_rise
-    fit = None
-    try:
-        for _ in range(params.surface_iterations):
-            pdata = PalpationData(
-                t_s=segment.t_s,
-                z_m=segment.z_m,
-                force_N=segment.force_N,
-                surface_z_m=surface,
-                z_target_m=segment.z_target_m,
-            )
-            fit = fit_hunt_crossley(
-                pdata, beta, indenter_mass_kg=params.indenter.indenter_mass_kg
-            )
-            stiffness = fit.kappa + fit.lam * max(-z_dot_rise, 0.0)
-            if not stiffness > 0:
-                break
-            surface = z_rise + (f_rise / stiffness) ** (1.0 / beta)
+
+    def fit_with_surface(surface_z_m: float):
         pdata = PalpationData(
             t_s=segment.t_s,
             z_m=segment.z_m,
             force_N=segment.force_N,
-            surface_z_m=surface,
+            surface_z_m=surface_z_m,
             z_target_m=segment.z_target_m,
         )
-        fit = fit_hunt_crossley(
+        return fit_hunt_crossley(
             pdata, beta, indenter_mass_kg=params.indenter.indenter_mass_kg
         )
+
+    fit = None
+    try:
+        for _ in range(params.surface_iterations):
+            fit = fit_with_surface(surface)
+            stiffness = fit.kappa + fit.lam * max(-z_dot_rise, 0.0)
+            if not stiffness > 0:
+                break
+            surface = z_rise + (f_rise / stiffness) ** (1.0 / beta)
+        fit = fit_with_surface(surface)
     except VicDrakeError as exc:
         return _failed(f"fit failed: {exc}", tare, noise)
     return PointFit(
