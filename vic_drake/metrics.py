@@ -495,6 +495,15 @@ def compare_contact_loss(sim: pd.DataFrame, real: pd.DataFrame) -> dict:
 # Phantom lift of the real disturbance logs.
 
 
+def _smoothed_rate(t: np.ndarray, v: np.ndarray, smooth_s: float) -> np.ndarray:
+    """d v / d t after a cubic Savitzky-Golay smoothing over about smooth_s."""
+    from scipy.signal import savgol_filter
+
+    dt = float(np.median(np.diff(t)))
+    window = max(5, int(round(smooth_s / dt)) | 1)
+    return np.gradient(savgol_filter(v, window, 3), t)
+
+
 def estimate_force_loop_gain(
     df: pd.DataFrame,
     *,
@@ -527,8 +536,6 @@ def estimate_force_loop_gain(
         ``z' = G (error - offset)``) and ``samples``; the
         figures are NaN when fewer than 100 contact samples exist.
     """
-    from scipy.signal import savgol_filter
-
     _require(df, "t_s", "z_m", "z_d_m", "force_sensor_z_N")
     t = df["t_s"].to_numpy(float)
     z = df["z_m"].to_numpy(float)
@@ -546,9 +553,7 @@ def estimate_force_loop_gain(
     nan = {"gain_m_per_s_per_N": np.nan, "r2": np.nan, "offset_N": np.nan, "samples": 0}
     if len(t) < 100:
         return nan
-    dt = float(np.median(np.diff(t)))
-    window = max(5, int(round(smooth_s / dt)) | 1)
-    vz = np.gradient(savgol_filter(z, window, 3), t)
+    vz = _smoothed_rate(t, z, smooth_s)
     net = k * (df["z_d_m"].to_numpy(float) - z) + f_ref - f
     use = contact_mask(df) & np.isfinite(net) & np.isfinite(vz)
     n = int(use.sum())
@@ -603,8 +608,6 @@ def estimate_tissue_friction(
         dict with ``tilt`` (a), ``friction_coefficient`` (mu), ``r2`` and
         ``samples``; NaN figures when fewer than 100 samples qualify.
     """
-    from scipy.signal import savgol_filter
-
     _require(df, "t_s", "x_m", "y_m", "force_sensor_x_N", "force_sensor_y_N",
              "force_sensor_z_N")
     nan = {"tilt": np.nan, "friction_coefficient": np.nan, "r2": np.nan, "samples": 0}
@@ -612,10 +615,7 @@ def estimate_tissue_friction(
     if len(t) < 100:
         return nan
     x, y = df["x_m"].to_numpy(float), df["y_m"].to_numpy(float)
-    dt = float(np.median(np.diff(t)))
-    window = max(5, int(round(smooth_s / dt)) | 1)
-    vx = np.gradient(savgol_filter(x, window, 3), t)
-    vy = np.gradient(savgol_filter(y, window, 3), t)
+    vx, vy = _smoothed_rate(t, x, smooth_s), _smoothed_rate(t, y, smooth_s)
     force = pressing_force_N(df)
     fx_w = -df["force_sensor_x_N"].to_numpy(float)  # External force in W.
     fy_w = -df["force_sensor_y_N"].to_numpy(float)
