@@ -154,7 +154,7 @@ def bench_diagram(params: ControllerParams, phantom, rows, ticks: int):
     simulator = Simulator(diagram)
     context = simulator.get_mutable_context()
     ports = [diagram.GetInputPort(n) for n in
-             ("ee_position", "ee_velocity", "target_position", "measured_force")]  # fmt: skip
+             ("probe.position", "probe.velocity", "target_position", "ft_sensor.force_W")]  # fmt: skip
     p_all, v_all, xd_all, f_all = rows
     simulator.Initialize()
     times, cpu_times = [], []

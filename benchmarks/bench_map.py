@@ -33,8 +33,7 @@ def peak_rss_mb() -> float:
 def designs(phantom, n: int) -> None:
     from pydrake.systems.analysis import Simulator
 
-    from vic_drake.estimation.campaign import CampaignParams, grid_points
-    from vic_drake.systems.indenter import MakeIndenterDiagram
+    from vic_drake.experiments import CampaignParams, MakeIndenterDiagram, grid_points
 
     params = CampaignParams()
     pal = params.palpation
@@ -100,8 +99,9 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
 
     os.environ.setdefault("MPLBACKEND", "Agg")
-    from vic_drake.estimation.campaign import CampaignParams, run_campaign
-    from vic_drake.estimation.gp_maps import build_tissue_map, compare_with_phantom
+    from vic_drake.analysis.map_compare import compare_with_phantom
+    from vic_drake.estimation.tissue_map import build_tissue_map
+    from vic_drake.experiments import CampaignParams, run_campaign
     from vic_drake.paths import has_data
     from vic_drake.tissue import GridPhantom, load_phantom
 

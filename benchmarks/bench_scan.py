@@ -24,6 +24,7 @@ tick (1.27-1.38 ms).
 from __future__ import annotations
 
 import argparse
+import copy
 import cProfile
 import io
 import pstats
@@ -65,14 +66,15 @@ def main() -> None:
         qp = replace(c.qp, solver=args.qp_solver)
         scenario = replace(scenario, controller=replace(c, qp=qp))
     if args.time_step_ms is not None:
-        station = replace(scenario.station, time_step_s=1e-3 * args.time_step_ms)
-        scenario = replace(scenario, station=station)
+        station = copy.deepcopy(scenario.station)
+        station.plant.time_step = 1e-3 * args.time_step_ms
+        scenario = replace(scenario, station=station.validate())
     t0 = time.perf_counter()
     result = run_scan(scenario, duration_s=args.duration)
     total = time.perf_counter() - t0
     print(f"scenario            {scenario.name}")
     print(
-        f"plant step          {1e3 * scenario.station.time_step_s:g} ms, "
+        f"plant step          {1e3 * scenario.station.plant.time_step:g} ms, "
         f"QP solver {scenario.controller.qp.solver}"
     )
     print(f"simulated           {result.sim_s:.2f} s")

@@ -130,7 +130,7 @@ def main(argv=None):
     params = StationParams(robot_contact=not args.no_robot_contact)
     print(
         f"phantom={args.phantom} robot_contact={params.robot_contact} "
-        f"time_step={params.time_step_s} s, {args.duration} s simulated per case"
+        f"time_step={params.plant.time_step} s, {args.duration} s simulated per case"
     )
     cases = {
         "free": lambda: _station_only(params, phantom, -0.02),

@@ -53,7 +53,7 @@ if DATA is not None:
     data = PalpationData.from_frame(read_bag(DATA / "palpation" / "test_soft_25hz"))
     lag = None  # estimated from the log
 else:
-    from vic_drake.estimation.campaign import CampaignParams, simulate_palpations
+    from vic_drake.experiments import CampaignParams, simulate_palpations
     from vic_drake.systems.indenter import PalpationParams
     from vic_drake.tissue import load_phantom
 
@@ -71,7 +71,7 @@ print(f"{data.n} samples over {data.duration_s:.1f} s")"""
         new_markdown_cell("## Table I: relative residual per model"),
         new_code_cell(
             """\
-from vic_drake.plots.offline import plot_table_i
+from vic_drake.reproduce.plots.offline import plot_table_i
 
 comparison = compare_models(data, (1.1, 1.35, 1.5), lag_s=lag, sweep=not SHORT)
 print(f"lag {comparison.lag_s * 1e3:.1f} ms")
@@ -87,21 +87,21 @@ plot_table_i(comparison)"""
         ),
         new_code_cell(
             """\
-from vic_drake.claims import residual_decay
-from vic_drake.plots.offline import plot_residual_vs_time
+from vic_drake.analysis.claims import residual_decay
+from vic_drake.reproduce.plots.offline import plot_residual_vs_time
 
 curve = residual_vs_palpation_time(shift(data, comparison.lag_s))
 print(residual_decay(curve.window_s, curve.relative))
 plot_residual_vs_time(curve)"""
         ),
         new_markdown_cell(
-            "## Claims C1 and C2\n\n`vic_drake.claims` turns these numbers into the "
+            "## Claims C1 and C2\n\n`vic_drake.analysis.claims` turns these numbers into the "
             "paper's claims with documented thresholds (the same functions the "
             "`vic-drake reproduce` report uses)."
         ),
         new_code_cell(
             """\
-from vic_drake import claims
+from vic_drake.analysis import claims
 
 res = claims.ModelResiduals(comparison.kelvin_voigt.relative,
                             {b: f.relative for b, f in comparison.hunt_crossley.items()})
@@ -126,7 +126,7 @@ def nb_scan_controllers():
         new_code_cell(SETUP),
         new_code_cell(
             """\
-from vic_drake.claims import scan_metrics
+from vic_drake.analysis.claims import scan_metrics
 from vic_drake.experiments import run_scan
 from vic_drake.reproduce import scan_limits, scan_scenario
 
@@ -141,13 +141,13 @@ for c in controllers:
         new_markdown_cell("## Fig. 6: force, stiffness, penetration and tank"),
         new_code_cell(
             """\
-from vic_drake.plots.scans import plot_fig6
+from vic_drake.reproduce.plots.scans import plot_fig6
 
 plot_fig6({c: r.df for c, r in runs.items()})"""
         ),
         new_markdown_cell(
             "## Metrics\n\nForce RMSE against the reference, force range, lift-off, "
-            "penetration off the ribs (see `vic_drake.claims.scan_metrics`)."
+            "penetration off the ribs (see `vic_drake.analysis.claims.scan_metrics`)."
         ),
         new_code_cell(
             """\
@@ -172,7 +172,7 @@ def nb_disturbance():
         new_code_cell(SETUP),
         new_code_cell(
             """\
-from vic_drake.claims import scan_metrics
+from vic_drake.analysis.claims import scan_metrics
 from vic_drake.experiments import run_scan
 from vic_drake.reproduce import scan_limits, scan_scenario
 
@@ -186,7 +186,7 @@ for c in controllers:
         ),
         new_code_cell(
             """\
-from vic_drake.plots.scans import plot_fig7
+from vic_drake.reproduce.plots.scans import plot_fig7
 
 plot_fig7({c: r.df for c, r in runs.items()})"""
         ),
@@ -219,7 +219,7 @@ def nb_real_vs_sim():
             """\
 import pandas as pd
 
-from vic_drake.claims import scan_metrics
+from vic_drake.analysis.claims import scan_metrics
 from vic_drake.realdata import read_bag
 from vic_drake.reproduce import REAL_LIMITS, REAL_SCAN_LOGS, real_scan_frame
 
@@ -237,7 +237,7 @@ pd.DataFrame({f"{c} ({cond})": scan_metrics(df, limits=REAL_LIMITS)
             """\
 if DATA is not None:
     from vic_drake.experiments import compare_real
-    from vic_drake.plots.scans import plot_comparison
+    from vic_drake.reproduce.plots.scans import plot_comparison
 
     out, sim_df, real_df = compare_real(DATA / "experiments" / "test_nardi_matForce_lowR",
                                         duration_s=3.0 if SHORT else None,

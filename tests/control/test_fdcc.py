@@ -4,16 +4,17 @@ import numpy as np
 import pytest
 from pydrake.math import RotationMatrix
 
-from vic_drake.control.fdcc import FdccModel, FdccParams, fdcc_step, net_cartesian_error
+from vic_drake.control.fdcc import FdccParams, fdcc_step, net_cartesian_error
 from vic_drake.errors import VicDrakeError
-from vic_drake.station import initial_q_for_tip, joint_filter_step, probe_down_rotation
+from vic_drake.models.ur3e import MakeFdccModel, probe_down_rotation
+from vic_drake.station import StationParams, initial_q_for_tip, joint_filter_step
 
 START = np.array([-0.06, -0.36, 0.13])
 
 
 @pytest.fixture(scope="module")
 def model():
-    return FdccModel(FdccParams())
+    return MakeFdccModel(FdccParams(), StationParams())
 
 
 @pytest.fixture(scope="module")

@@ -8,7 +8,7 @@ from vic_drake.estimation.palpation import HuntCrossleyFit, KelvinVoigtFit
 from vic_drake.realdata import read_bag
 from vic_drake.tissue import hunt_crossley_force
 
-from .test_palpation import SURFACE_Z_M, synthetic_palpation
+from .palpation.synthetic import SURFACE_Z_M, synthetic_palpation
 
 LOAD_LOGS = ("test_soft_1", "test_soft_2", "test_soft_3")
 
@@ -85,7 +85,7 @@ def test_hunt_crossley_predicts_real_load_tests_better(data_dir, soft_1hz, name)
 
 
 def test_load_test_figure(tmp_path):
-    from vic_drake.plots.offline import plot_load_test
+    from vic_drake.reproduce.plots.offline import plot_load_test
 
     result = load_test(synthetic_load_test(), synthetic_palpation(), lag_s=0.0)
     fig = plot_load_test(result, save_path=tmp_path / "fig2.png")

@@ -14,10 +14,8 @@ from vic_drake.control.params import (
     StiffnessQpParams,
     TankParams,
 )
-from vic_drake.control.stiffness_qp import (
-    make_stiffness_qp_problem,
-    solve_stiffness_qp_exact,
-)
+from vic_drake.control.stiffness_qp.exact import solve_stiffness_qp_exact
+from vic_drake.control.stiffness_qp.problem import make_stiffness_qp_problem
 from vic_drake.control.tank import tank_step
 from vic_drake.errors import VicDrakeError
 from vic_drake.systems.controller import MakeVariableImpedanceController
@@ -57,8 +55,8 @@ def make(phantom, controller="vs-cf", **kw):
     params = ControllerParams(reference=ReferenceParams(controller=controller), **kw)
     diagram = MakeVariableImpedanceController(params, phantom=phantom)
     context = diagram.CreateDefaultContext()
-    for name, value in (("ee_position", P_WP), ("ee_velocity", V_WP), ("target_position", X_D),
-                        ("measured_force", F_W)):  # fmt: skip
+    for name, value in (("probe.position", P_WP), ("probe.velocity", V_WP), ("target_position", X_D),
+                        ("ft_sensor.force_W", F_W)):  # fmt: skip
         diagram.GetInputPort(name).FixValue(context, value)
     return params, diagram, context
 
@@ -80,10 +78,10 @@ def test_ports_match_the_interface(phantom):
     outputs = {diagram.get_output_port(i).get_name(): diagram.get_output_port(i).size()
                for i in range(diagram.num_output_ports())}  # fmt: skip
     assert inputs == {
-        "ee_position": 3,
-        "ee_velocity": 3,
+        "probe.position": 3,
+        "probe.velocity": 3,
         "target_position": 3,
-        "measured_force": 3,
+        "ft_sensor.force_W": 3,
     }
     assert outputs == {"stiffness": 3, "damping": 3, "target_force": 3, "force_reference": 3,
                        "force_min": 3, "tank": 4, "status": 6}  # fmt: skip
@@ -148,17 +146,17 @@ def test_tank_and_qp_stay_in_step_over_many_ticks(phantom):
 
 
 @pytest.mark.parametrize(
-    "port", ["ee_position", "ee_velocity", "target_position", "measured_force"]
+    "port", ["probe.position", "probe.velocity", "target_position", "ft_sensor.force_W"]
 )
 @pytest.mark.parametrize("bad", [math.nan, math.inf])
 def test_non_finite_measurement_gives_k_min_and_fault(phantom, port, bad):
     params, diagram, context = make(phantom, "vs-vf")
     tick(diagram, context, 3)
     value = {
-        "ee_position": P_WP,
-        "ee_velocity": V_WP,
+        "probe.position": P_WP,
+        "probe.velocity": V_WP,
         "target_position": X_D,
-        "measured_force": F_W,
+        "ft_sensor.force_W": F_W,
     }[port].copy()
     value[2] = bad
     diagram.GetInputPort(port).FixValue(context, value)
@@ -172,8 +170,8 @@ def test_non_finite_measurement_gives_k_min_and_fault(phantom, port, bad):
         assert np.all(np.isfinite(diagram.get_output_port(i).Eval(context))), (
             diagram.get_output_port(i).get_name()
         )
-    diagram.GetInputPort(port).FixValue(context, {"ee_position": P_WP, "ee_velocity": V_WP,
-                                                  "target_position": X_D, "measured_force": F_W}[port])  # fmt: skip
+    diagram.GetInputPort(port).FixValue(context, {"probe.position": P_WP, "probe.velocity": V_WP,
+                                                  "target_position": X_D, "ft_sensor.force_W": F_W}[port])  # fmt: skip
     tick(diagram, context)
     assert out(diagram, context, "status")[2] == 0.0  # Recovers; the count stays.
     assert out(diagram, context, "status")[1] == 2.0
@@ -272,7 +270,7 @@ def test_surface_velocity_moving_average_in_the_system(sloped):
     params, diagram, context = make(sloped, "vs-cf")
     tick(diagram, context)  # Records the height under P_WP.
     p2 = P_WP + np.array([-0.001, 0.0, 0.0])  # 1 mm along -x: surface 0.2 mm lower.
-    diagram.GetInputPort("ee_position").FixValue(context, p2)
+    diagram.GetInputPort("probe.position").FixValue(context, p2)
     tick(diagram, context)  # The state ports publish what this tick used.
     ref = diagram.GetSubsystemByName("force_reference")
     contact = ref.get_contact_output_port().Eval(ref.GetMyContextFromRoot(context))
@@ -289,8 +287,8 @@ def test_surface_velocity_gradient_mode(sloped):
     )
     diagram = MakeVariableImpedanceController(params, phantom=sloped)
     context = diagram.CreateDefaultContext()
-    for name, value in (("ee_position", P_WP), ("ee_velocity", V_WP), ("target_position", X_D),
-                        ("measured_force", F_W)):  # fmt: skip
+    for name, value in (("probe.position", P_WP), ("probe.velocity", V_WP), ("target_position", X_D),
+                        ("ft_sensor.force_W", F_W)):  # fmt: skip
         diagram.GetInputPort(name).FixValue(context, value)
     eps_dot = 0.2 * V_WP[0] - V_WP[2]  # grad z . v minus z_dot.
     f_ref_z = -(KAPPA + LAM * eps_dot) * 0.008**BETA
@@ -340,9 +338,9 @@ def test_random_closed_sequences_keep_tank_and_bounds(
     )
     for dp, v, fz in steps:
         p = p + np.array(dp)
-        diagram.GetInputPort("ee_position").FixValue(context, p)
-        diagram.GetInputPort("ee_velocity").FixValue(context, np.array(v))
-        diagram.GetInputPort("measured_force").FixValue(context, [0.0, 0.0, fz])
+        diagram.GetInputPort("probe.position").FixValue(context, p)
+        diagram.GetInputPort("probe.velocity").FixValue(context, np.array(v))
+        diagram.GetInputPort("ft_sensor.force_W").FixValue(context, [0.0, 0.0, fz])
         tick(diagram, context)
         tank = out(diagram, context, "tank")
         k = out(diagram, context, "stiffness")

@@ -28,7 +28,9 @@ def _fix_inputs(system, context, q, *, stiffness=(300.0, 300.0, 300.0)):
 
 
 def test_ports_and_one_tick_equals_the_pure_step(q_start):
-    system = FdccController(FdccParams(), initial_q=q_start)
+    system = FdccController(
+        FdccParams(), station_params=StationParams(), initial_q=q_start
+    )
     for name, size in [
         ("joint_positions", 6),
         ("target_position", 3),
@@ -79,7 +81,9 @@ def test_ports_and_one_tick_equals_the_pure_step(q_start):
 
 
 def test_nan_input_holds_the_command_and_flags(q_start):
-    system = FdccController(FdccParams(), initial_q=q_start)
+    system = FdccController(
+        FdccParams(), station_params=StationParams(), initial_q=q_start
+    )
     context = system.CreateDefaultContext()
     _fix_inputs(system, context, q_start)
     context.SetDiscreteState(system.EvalUniquePeriodicDiscreteUpdate(context))

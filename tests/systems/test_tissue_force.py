@@ -172,3 +172,26 @@ def test_optional_force_along_the_surface_normal():
         normal.force_W, vertical.force_N * np.array([-0.2, 0.1, 1.0])
     )
     np.testing.assert_allclose(vertical.force_W, [0.0, 0.0, vertical.force_N])
+
+
+def test_ports_carry_the_station_signal_names():
+    """One name per signal: the element's ports are named as the station exports them."""
+    system = TissueForceElement(
+        _plane_phantom(),
+        indenter_body_index=BodyIndex(1),
+        p_BT=np.zeros(3),
+        phantom_body_index=BodyIndex(2),
+    )
+    outputs = {system.get_output_port(i).get_name(): system.get_output_port(i).size()
+               for i in range(system.num_output_ports())
+               if system.get_output_port(i).get_data_type().name == "kVectorValued"}  # fmt: skip
+    assert outputs == {
+        "tissue.force_W": 3,
+        "tissue.penetration": 1,
+        "tissue.surface_z": 1,
+        "probe.position": 3,
+        "probe.velocity": 3,
+    }
+    assert system.get_force_output_port().get_name() == "tissue.force_W"
+    assert system.get_tip_position_output_port().get_name() == "probe.position"
+    assert system.get_tip_velocity_output_port().get_name() == "probe.velocity"

@@ -3,14 +3,10 @@
 from __future__ import annotations
 
 import argparse
-import json
-import math
 import sys
-from pathlib import Path
-
-import numpy as np
 
 from vic_drake.errors import VicDrakeError
+from vic_drake.jsonio import to_json
 from vic_drake.paths import DATA_ENV_VAR
 
 
@@ -28,30 +24,6 @@ def add_json_option(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--json", action="store_true", help="print only the result as JSON on stdout"
     )
-
-
-def _jsonable(value):
-    if isinstance(value, dict):
-        return {str(k): _jsonable(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_jsonable(v) for v in value]
-    if isinstance(value, (np.floating, float)):
-        value = float(value)
-        return value if math.isfinite(value) else None
-    if isinstance(value, np.integer):
-        return int(value)
-    if isinstance(value, np.bool_):
-        return bool(value)
-    if isinstance(value, np.ndarray):
-        return _jsonable(value.tolist())
-    if isinstance(value, Path):
-        return str(value)
-    return value
-
-
-def to_json(result: dict) -> str:
-    """JSON text of a result dict (numpy scalars converted, NaN/inf -> null)."""
-    return json.dumps(_jsonable(result), indent=2, allow_nan=False)
 
 
 def emit(result: dict, as_json: bool, human: str | None = None) -> None:

@@ -31,7 +31,6 @@ from vic_drake.errors import VicDrakeError
 
 MAX_MAP_POINTS = 20_000_000  # 2001 x 1001 at 0.1 mm over 20 x 10 cm is 2 M.
 MAX_PALPATION_POINTS = 5_000
-PAPER_REGION_SIZE_M = (0.20, 0.10)  # The region palpated in the paper (x, y).
 METRIC_KEYS = (
     "points",
     "kappa_rmse_pct",
@@ -133,22 +132,6 @@ def _parse_region(text: str) -> tuple[float, float, float, float]:
     return values
 
 
-def default_region(phantom) -> tuple[float, float, float, float]:
-    """The measured map's own grid; for an analytic chest its central 20 x 10 cm."""
-    x_min, x_max, y_min, y_max = (float(v) for v in phantom.bounds)
-    params = getattr(phantom, "params", None)
-    if params is None or not hasattr(params, "center_x_m"):
-        return (x_min, x_max, y_min, y_max)
-    hx, hy = PAPER_REGION_SIZE_M[0] / 2, PAPER_REGION_SIZE_M[1] / 2
-    cx, cy = params.center_x_m, params.center_y_m
-    return (
-        max(x_min, cx - hx),
-        min(x_max, cx + hx),
-        max(y_min, cy - hy),
-        min(y_max, cy + hy),
-    )
-
-
 def _prepare_out(path: str) -> Path:
     out = Path(path).expanduser()
     if out.exists() and not out.is_dir():
@@ -163,12 +146,14 @@ def _prepare_out(path: str) -> Path:
 
 
 def run_map(args) -> int:
-    from vic_drake.estimation.campaign import CampaignParams, grid_points, run_campaign
-    from vic_drake.estimation.gp_maps import (
-        KERNELS,
-        GpMapParams,
-        build_tissue_map,
-        compare_with_phantom,
+    # Heavy (pydrake, scikit-learn): imported when the command runs, not when
+    # the parser is built.
+    from vic_drake.estimation.gp_fit import KERNELS, GpMapParams
+    from vic_drake.experiments import (
+        CampaignParams,
+        default_region,
+        grid_points,
+        run_map_pipeline,
     )
     from vic_drake.systems.indenter import IndenterParams
     from vic_drake.tissue.phantom import PHANTOM_KINDS, load_phantom
@@ -213,7 +198,7 @@ def run_map(args) -> int:
             f"{args.spacing_cm:g}; a map needs at least 4"
         )
 
-    campaign = run_campaign(
+    mapped = run_map_pipeline(
         phantom,
         CampaignParams(
             indenter=IndenterParams(time_step_s=time_step_s),
@@ -222,17 +207,11 @@ def run_map(args) -> int:
             seed=args.seed,
             workers=args.workers,
         ),
-        progress=progress,
-    )
-    tmap = build_tissue_map(
-        campaign.points,
-        region,
-        beta=campaign.beta,
         resolution_m=resolution_m,
         gp=GpMapParams(kernel=args.kernel, seed=args.seed, log_target=args.log_gp),
         progress=progress,
     )
-    comparison = compare_with_phantom(tmap, phantom)
+    campaign, tmap, comparison = mapped.campaign, mapped.tissue_map, mapped.comparison
     tmap.save_npz(out / "maps.npz")
     campaign.points.to_csv(out / "points.csv", index=False)
     if not args.no_figures:
@@ -251,7 +230,7 @@ def run_map(args) -> int:
     (out / "metrics.json").write_text(to_json(result) + "\n")
     details = {
         "phantom": args.phantom,
-        "region_m": list(region),
+        "region_m": list(mapped.region_m),
         "spacing_m": spacing_m,
         "resolution_m": resolution_m,
         "palpated": len(campaign.points),
@@ -284,7 +263,7 @@ def _cm(values) -> str:
 
 
 def _figures(tmap, phantom, comparison, out: Path) -> None:
-    from vic_drake.plots.maps import (
+    from vic_drake.reproduce.plots.maps import (
         plot_map_vs_truth,
         plot_std_maps,
         plot_stiffness_damping_maps,
@@ -325,4 +304,4 @@ def _decimated_truth_kappa(tmap, phantom, *, max_pixels: int):
     return small, phantom.sample(X, Y).kappa
 
 
-__all__ = ["METRIC_KEYS", "default_region", "register", "run_map"]
+__all__ = ["METRIC_KEYS", "register", "run_map"]

@@ -157,7 +157,7 @@ def _fit_palpation(args: argparse.Namespace) -> int:
         "best_beta": result.best_beta,
     }
     if args.plot:
-        from vic_drake.plots.offline import plot_palpation_summary
+        from vic_drake.reproduce.plots.offline import plot_palpation_summary
 
         plot_palpation_summary(result, title=str(args.bag_dir), save_path=args.plot)
         say(f"wrote {args.plot}")
@@ -221,7 +221,7 @@ def _load_test(args: argparse.Namespace) -> int:
         "beta": result.beta,
     }
     if args.plot:
-        from vic_drake.plots.offline import plot_load_test
+        from vic_drake.reproduce.plots.offline import plot_load_test
 
         plot_load_test(result, title=str(args.bag_dir), save_path=args.plot)
         say(f"wrote {args.plot}")

@@ -149,7 +149,7 @@ def run_compare_real(args: argparse.Namespace) -> int:
     if args.out:
         out["sim_log"] = str(_save_log(sim, args.out))
     if args.plot:
-        from vic_drake.plots.scans import plot_comparison
+        from vic_drake.reproduce.plots.scans import plot_comparison
 
         plot_comparison(sim, real, title=Path(args.bag_dir).name, save_path=args.plot)
     ordered = {k: out.get(k) for k in COMPARE_KEYS}
@@ -166,7 +166,7 @@ def run_compare_real(args: argparse.Namespace) -> int:
 
 
 def run_scan_command(args: argparse.Namespace) -> int:
-    from vic_drake import metrics
+    from vic_drake.analysis import contact, scan_metrics
     from vic_drake.experiments import run_scan
     from vic_drake.scenario import load_scenario, save_scenario
 
@@ -184,12 +184,12 @@ def run_scan_command(args: argparse.Namespace) -> int:
         # CS has no force reference: its RMSE against one is undefined.
         "force_rmse_N": None
         if scenario.controller.reference.controller == "cs"
-        else metrics.force_rmse_N(df),
-        "force_range_N": list(metrics.force_range_N(df)),
-        "force_peak_N": metrics.peak_force_N(df),
-        "tank_min_J": metrics.tank_min_J(df),
-        "contact_loss_s": [list(i) for i in metrics.contact_loss_intervals(df)],
-        "lifted_off": metrics.lifted_off(df),
+        else scan_metrics.force_rmse_N(df),
+        "force_range_N": list(scan_metrics.force_range_N(df)),
+        "force_peak_N": scan_metrics.peak_force_N(df),
+        "tank_min_J": scan_metrics.tank_min_J(df),
+        "contact_loss_s": [list(i) for i in contact.contact_loss_intervals(df)],
+        "lifted_off": scan_metrics.lifted_off(df),
     }
     if args.out:
         path = _save_log(df, args.out)

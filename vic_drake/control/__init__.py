@@ -9,9 +9,11 @@ Pure functions and dataclasses; the Drake LeafSystems that wrap them live in
   ``reference: ReferenceParams``), defaults of the real controller.
 - :mod:`vic_drake.control.tank`: ``tank_step`` (T, dT/dt, sigma, enabled),
   ``tank_qp_rows``.
-- :mod:`vic_drake.control.stiffness_qp`: ``make_stiffness_qp_problem``,
-  ``solve_stiffness_qp_exact`` (closed-form oracle and fast path),
-  ``StiffnessQp`` (MathematicalProgram built once; OSQP or Clarabel).
+- :mod:`vic_drake.control.stiffness_qp` (a package, one concept per
+  module): ``problem`` (``make_stiffness_qp_problem``), ``constraints``
+  (active-constraint mask), ``exact`` (``solve_stiffness_qp_exact``, the
+  closed-form oracle and fast path), ``program`` (``StiffnessQp``, the
+  MathematicalProgram built once; OSQP or Clarabel).
 - :mod:`vic_drake.control.references`: contact, penetration rate,
   surface-velocity filter, ``force_references`` of CS, CF, VS-CF, VS-VF,
   ``scalar_sampler`` (fast map lookup).

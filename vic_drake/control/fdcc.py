@@ -34,23 +34,27 @@ tick (500 Hz):
 
 3. the resulting q is the joint position command.
 
-Everything here is plain numpy on a MultibodyPlant context; the LeafSystem
+Everything here is plain numpy on a MultibodyPlant context that the caller
+builds (:func:`vic_drake.models.ur3e.MakeFdccModel`); the LeafSystem
 (:class:`vic_drake.systems.fdcc.FdccController`) holds the state.
+
+:class:`FdccParams` is a mutable dataclass loadable by Drake's
+``yaml_load_typed`` (which fills a default instance field by field), so it
+validates in ``__post_init__`` and again in :meth:`FdccParams.validate`. (No
+``from __future__ import annotations`` here: the YAML loader reads the field
+types at run time.)
 """
 
-from __future__ import annotations
-
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from pydrake.common.eigen_geometry import Quaternion
-from pydrake.math import RigidTransform, RotationMatrix
+from pydrake.math import RotationMatrix
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import JacobianWrtVariable, SpatialInertia, UnitInertia
 from scipy.linalg.lapack import dgesv
 
 from vic_drake.errors import VicDrakeError
-from vic_drake.station import UR3E_JOINTS, AddUr3e, StationParams
 
 
 def _check_vec(name, value, n, *, nonneg=False):
@@ -74,33 +78,41 @@ class FdccParams:
     iterations: int = 1  # Internal steps per tick.
     error_scale: float = 0.5  # Scales the PD output (solver.error_scale).
     # Proportional gains of the Cartesian PD (x, y: 0.05; z: 0.3; rotation: 1.5).
-    p_gains: tuple[float, ...] = (0.05, 0.05, 0.3, 1.5, 1.5, 1.5)
-    # Derivative gains, s (x, y: 0.005; z: 0.01; rotation: none).
-    d_gains: tuple[float, ...] = (0.005, 0.005, 0.01, 0.0, 0.0, 0.0)
-    # Rotational stiffness about x, y, z of W, N m/rad.
-    rotational_stiffness_Nm_per_rad: tuple[float, float, float] = (50.0, 50.0, 50.0)
-    link_mass_kg: float = (
-        0.1  # Mass of each moving link of the model, kg (FZI default).
+    p_gains: list[float] = field(
+        default_factory=lambda: [0.05, 0.05, 0.3, 1.5, 1.5, 1.5]
     )
+    # Derivative gains, s (x, y: 0.005; z: 0.01; rotation: none).
+    d_gains: list[float] = field(
+        default_factory=lambda: [0.005, 0.005, 0.01, 0.0, 0.0, 0.0]
+    )
+    # Rotational stiffness about x, y, z of W, N m/rad.
+    rotational_stiffness_Nm_per_rad: list[float] = field(
+        default_factory=lambda: [50.0, 50.0, 50.0]
+    )
+    # Mass of each moving link of the model, kg (FZI default).
+    link_mass_kg: float = 0.1
     link_inertia_kg_m2: float = 1e-6  # Their rotational inertia, kg m^2.
     end_effector_mass_kg: float = 1.0  # Model mass at the probe frame, kg.
     end_effector_inertia_kg_m2: float = 1.0  # Its rotational inertia, kg m^2.
-    velocity_decay: float = (
-        0.9  # Internal velocity factor per step (FZI: 10 % damping).
-    )
+    # Internal velocity factor per step (FZI: 10 % damping).
+    velocity_decay: float = 0.9
     # Target orientation of the probe frame, quaternion (w, x, y, z): pointing down.
-    target_orientation_wxyz: tuple[float, float, float, float] = (0.0, 1.0, 0.0, 0.0)
+    target_orientation_wxyz: list[float] = field(
+        default_factory=lambda: [0.0, 1.0, 0.0, 0.0]
+    )
     # Pose in the Cartesian error: "measured" (of the synchronised measured
     # joints) or "command" (FZI: the model's pose after the previous tick's
     # step, i.e. of the last command). H and J use the measured joints in
-    # both. Default "measured": in this simulation, whose joint servo trails
-    # the command, "command" makes the VS-VF replay of
-    # test_nardi_matForce_lowR ring (force RMSE against the log 2.25 N, K_z
-    # correlation 0.66) where the measured pose reproduces the log (0.65 N,
-    # 0.76); the VS-CF replay is good with either.
+    # both. Default "measured": with this simulation's trailing joint servo,
+    # "command" makes a VS-VF replay ring; see docs/decisions.md, "FDCC pose
+    # feedback".
     pose_feedback: str = "measured"
 
     def __post_init__(self):
+        self.validate()
+
+    def validate(self) -> "FdccParams":
+        """Checks every field; raises VicDrakeError naming the bad one. Returns self."""
         for name in (
             "period_s",
             "internal_period_s",
@@ -145,6 +157,7 @@ class FdccParams:
                 "FdccParams.target_orientation_wxyz must be a unit quaternion (w, x, y, z), "
                 f"got {self.target_orientation_wxyz!r}"
             )
+        return self
 
     @property
     def R_WP_target(self) -> RotationMatrix:
@@ -155,32 +168,25 @@ class FdccParams:
 
 
 class FdccModel:
-    """FZI's generic internal model of the UR3e (see the module docstring).
+    """FZI's generic internal model of the arm (see the module docstring).
 
     Holds a MultibodyPlant and a scratch context whose positions are written
-    before every use; it carries no state between calls.
+    before every use; it carries no state between calls. The caller builds
+    the plant (:func:`vic_drake.models.ur3e.MakeFdccModel` for the UR3e);
+    this class gives every moving link (the child body of each joint with
+    velocities) the light inertia of ``params`` in its context.
     """
 
-    def __init__(self, params: FdccParams, station_params=None):
-        station_params = station_params or StationParams()
-        plant = MultibodyPlant(0.0)
-        ur3e = AddUr3e(plant)
-        X_3P = station_params.X_W3M @ RigidTransform(station_params.p_MP)
-        ee = plant.AddRigidBody(
-            "fdcc_end_effector",
-            ur3e,
-            SpatialInertia(
-                params.end_effector_mass_kg,
-                np.zeros(3),
-                UnitInertia.TriaxiallySymmetric(
-                    params.end_effector_inertia_kg_m2 / params.end_effector_mass_kg
-                ),
-            ),
-        )
-        plant.WeldFrames(
-            plant.GetFrameByName("wrist_3_link", ur3e), ee.body_frame(), X_3P
-        )
-        plant.Finalize()
+    def __init__(self, params: FdccParams, plant: MultibodyPlant, frame):
+        """
+        Args:
+            params: the FDCC settings (link mass and inertia).
+            plant: a finalized MultibodyPlant of the arm, its end-effector
+                body already carrying the model's end-effector inertia.
+            frame: the end-effector frame of ``plant`` (the probe frame P).
+        """
+        if not plant.is_finalized():
+            raise VicDrakeError("FdccModel needs a finalized MultibodyPlant")
         context = plant.CreateDefaultContext()
         light = SpatialInertia(
             params.link_mass_kg,
@@ -189,13 +195,13 @@ class FdccModel:
                 params.link_inertia_kg_m2 / params.link_mass_kg
             ),
         )
-        for name in UR3E_JOINTS:
-            plant.GetJointByName(name, ur3e).child_body().SetSpatialInertiaInBodyFrame(
-                context, light
-            )
+        for index in plant.GetJointIndices():
+            joint = plant.get_joint(index)
+            if joint.num_velocities() > 0:
+                joint.child_body().SetSpatialInertiaInBodyFrame(context, light)
         self.plant = plant
-        self.ur3e = ur3e
-        self.frame = ee.body_frame()
+        self.ur3e = frame.body().model_instance()
+        self.frame = frame
         self._context = context
         self._world = plant.world_frame()
         self._p_origin = np.zeros(3)

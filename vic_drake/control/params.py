@@ -20,9 +20,17 @@ import math
 from dataclasses import dataclass, field
 
 from vic_drake.errors import VicDrakeError
+from vic_drake.paper import CONTACT_THRESHOLD_N, CONTROLLERS
 
-#: The four controllers of the paper (Sec. II-B and Sec. III-C).
-CONTROLLERS = ("cs", "cf", "vs-cf", "vs-vf")
+__all__ = [
+    "CONTROLLERS",  # Re-exported from vic_drake.paper (its old home).
+    "SURFACE_VELOCITY_MODES",
+    "ControllerParams",
+    "ReferenceParams",
+    "StiffnessQpParams",
+    "TankParams",
+    "real_controller_params",
+]
 
 #: Modes of the surface-velocity estimate used in the penetration rate.
 SURFACE_VELOCITY_MODES = ("moving_average", "gradient")
@@ -131,12 +139,11 @@ class StiffnessQpParams:
         damping_ratio: zeta in D = 2 zeta sqrt(K) (real controller: 0.707).
         solver: "osqp" (default) or "clarabel", through Drake's
             MathematicalProgram, or "exact", the closed-form solver of this
-            package (same answer to ~1e-10 N/m on the real logs, ~10x
-            cheaper per tick: the fast path).
+            package (the same answer, cheaper per tick: the fast path; see
+            docs/decisions.md, "Stiffness QP solvers and scaling").
         osqp_eps: OSQP eps_abs = eps_rel. OSQP runs without its polishing
-            step (which prints notes on stdout), so the tolerance is tight:
-            with 1e-12, K agrees with the exact answer within 2e-7 N/m on
-            3,000 random problems and 1e-9 N/m on the real logs (measured).
+            step (which prints notes on stdout), so the tolerance is tight
+            (see docs/decisions.md, "OSQP settings").
     """
 
     q_weight: list[float] = field(default_factory=lambda: [3200.0, 3200.0, 3200.0])
@@ -239,7 +246,7 @@ class ReferenceParams:
     force_min_z_N: float = -9.0
     eps_max_m: float = 0.008
     eps_d_m: float = 0.008
-    contact_threshold_N: float = 0.5
+    contact_threshold_N: float = CONTACT_THRESHOLD_N
     constant_stiffness_N_per_m: list[float] = field(
         default_factory=lambda: [400.0, 400.0, 400.0]
     )

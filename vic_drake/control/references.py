@@ -175,10 +175,10 @@ def uses_qp(ref: ReferenceParams) -> bool:
 def scalar_sampler(phantom):
     """A fast scalar lookup ``f(x, y) -> (surface_z, dz_dx, dz_dy, kappa, lam)``.
 
-    ``Phantom.sample`` is vectorised numpy and costs 50-100 us for one
-    point, a large share of a tick's budget; this returns the phantom's
-    cached :class:`~vic_drake.tissue.PointLookup` (a few us; exact for a
-    GridPhantom, a 0.5 mm rasterization otherwise).
+    ``Phantom.sample`` is vectorised numpy, costly for one point at every
+    tick (see docs/decisions.md, "Phantom lookup per tick"); this returns
+    the phantom's cached :class:`~vic_drake.tissue.PointLookup` (exact for
+    a GridPhantom, a 0.5 mm rasterization otherwise).
     """
     return phantom.point_lookup()
 

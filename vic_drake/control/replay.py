@@ -35,9 +35,16 @@ import numpy as np
 import pandas as pd
 
 from vic_drake.control.params import ControllerParams
-from vic_drake.control.stiffness_qp import StiffnessQp, make_stiffness_qp_problem
+from vic_drake.control.references import (
+    force_references,
+    in_contact,
+    penetration_rate,
+)
+from vic_drake.control.stiffness_qp.problem import make_stiffness_qp_problem
+from vic_drake.control.stiffness_qp.program import StiffnessQp
 from vic_drake.control.tank import tank_step
 from vic_drake.errors import VicDrakeError
+from vic_drake.realdata import read_bag
 
 
 @dataclass
@@ -226,8 +233,6 @@ def replay_bag(
     solver: str | None = None,
 ) -> ReplayResult:
     """Reads a controller bag and replays it (see :func:`replay_controller_log`)."""
-    from vic_drake.realdata import read_bag
-
     return replay_controller_log(
         read_bag(bag_dir, expect="controller"), params, r_weight=r_weight, solver=solver
     )
@@ -240,12 +245,6 @@ def reference_errors(df: pd.DataFrame, params: ControllerParams | None = None) -
     force; the controller kind is ``params.reference.controller`` ("vs-cf"
     or "vs-vf"). Returns max abs errors (N) and the contact mismatch count.
     """
-    from vic_drake.control.references import (
-        force_references,
-        in_contact,
-        penetration_rate,
-    )
-
     params = ControllerParams() if params is None else params
     ref, qp = params.reference, params.qp
     f_ref_err = f_min_err = 0.0

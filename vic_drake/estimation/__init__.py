@@ -1,16 +1,15 @@
 """Offline estimation of tissue parameters from palpation logs.
 
-Public names of the palpation fits (helper modules of other areas, e.g. the
-palpation campaign and the GP maps, are imported from their own modules).
+Public names of the palpation fits and the load test; the surface fit and
+the GP maps are imported from their own modules. This layer is pure
+fitting math: the simulated palpation campaign that feeds it lives in
+:mod:`vic_drake.experiments`.
 """
 
 from vic_drake.estimation.loadtest import LoadTestResult, load_test, predict_force
 from vic_drake.estimation.palpation import (
-    DEFAULT_BETA,
     DEFAULT_INDENTER_MASS_KG,
     DEFAULT_MAX_LAG_S,
-    PAPER_TABLE_I,
-    TABLE_I_BETAS,
     BetaSweep,
     ExponentialFit,
     HuntCrossleyFit,
@@ -40,12 +39,9 @@ from vic_drake.estimation.signals import (
 )
 
 __all__ = [
-    "DEFAULT_BETA",
     "DEFAULT_DERIVATIVE_WINDOW_S",
     "DEFAULT_INDENTER_MASS_KG",
     "DEFAULT_MAX_LAG_S",
-    "PAPER_TABLE_I",
-    "TABLE_I_BETAS",
     "BetaSweep",
     "ExponentialFit",
     "HuntCrossleyFit",

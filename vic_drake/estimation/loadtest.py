@@ -1,9 +1,10 @@
 """Load/unload test (Fig. 2): palpation-fitted models predict a load cycle.
 
 Kelvin-Voigt and Hunt-Crossley parameters are fitted on a sinusoidal
-palpation (:func:`vic_drake.estimation.palpation.compare_models` pipeline:
-lag, alignment, least squares) and then predict the force of a
-constant-velocity load test from its measured tip trajectory alone:
+palpation (the pipeline of
+:func:`vic_drake.estimation.palpation.table_i.compare_models`: lag,
+alignment, least squares) and then predict the force of a constant-velocity
+load test from its measured tip trajectory alone:
 
     F_pred = F_tissue(eps, eps_dot) - m_I z_ddot,
 
@@ -22,23 +23,24 @@ from dataclasses import dataclass
 import numpy as np
 
 from vic_drake.errors import VicDrakeError
-from vic_drake.estimation.palpation import (
-    DEFAULT_BETA,
+from vic_drake.estimation.palpation.data import (
     DEFAULT_INDENTER_MASS_KG,
-    DEFAULT_MAX_LAG_S,
     DEFAULT_MIN_FORCE_N,
-    HuntCrossleyFit,
-    KelvinVoigtFit,
     PalpationData,
-    _check_beta,
-    estimate_lag,
-    fit_hunt_crossley,
-    fit_kelvin_voigt,
     kinematics,
     shift,
     spike_mask,
 )
+from vic_drake.estimation.palpation.fits import (
+    HuntCrossleyFit,
+    KelvinVoigtFit,
+    _check_beta,
+    fit_hunt_crossley,
+    fit_kelvin_voigt,
+)
+from vic_drake.estimation.palpation.lag import DEFAULT_MAX_LAG_S, estimate_lag
 from vic_drake.estimation.signals import DEFAULT_DERIVATIVE_WINDOW_S
+from vic_drake.paper import BEST_BETA
 
 MIN_LOAD_SAMPLES = 50
 
@@ -92,7 +94,7 @@ def load_test(
     load: PalpationData,
     palpation: PalpationData,
     *,
-    beta: float = DEFAULT_BETA,
+    beta: float = BEST_BETA,
     lag_s: float | None = None,
     max_lag_s: float = DEFAULT_MAX_LAG_S,
     indenter_mass_kg: float = DEFAULT_INDENTER_MASS_KG,

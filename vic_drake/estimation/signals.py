@@ -2,18 +2,17 @@
 shifts and smoothed derivatives of logged positions.
 
 The real rig logs at about 500 Hz with slightly uneven timestamps (the
-UR3e's 2 ms tick, jittered by ROS by up to ~0.3 ms). Every function here
+UR3e's 2 ms tick, jittered by ROS). Every function here
 accepts uneven timestamps: derivatives are computed on a uniform grid at the
 median sample period (linear interpolation onto the grid, Savitzky-Golay
 there) and interpolated back onto the original timestamps, so callers never
 see the grid.
 
 Smoothing: a cubic Savitzky-Golay filter over a window of
-:data:`DEFAULT_DERIVATIVE_WINDOW_S` = 0.05 s (25 samples at 500 Hz). A cubic
-fit over 0.05 s passes a 2.5 Hz sinusoid (the fastest palpation) with
-amplitude error below 0.1 % in z, 0.5 % in z-dot and 2 % in z-ddot, while it
-averages the tick-level jitter of the logged tip height (a few micrometres)
-that makes a raw finite difference of z-ddot useless.
+:data:`DEFAULT_DERIVATIVE_WINDOW_S` = 0.05 s (25 samples at 500 Hz). It
+passes the fastest palpation (2.5 Hz) nearly unchanged while it averages the
+tick-level jitter of the logged tip height that makes a raw finite
+difference of z-ddot useless (docs/decisions.md, "Derivative window").
 """
 
 from __future__ import annotations

@@ -6,7 +6,7 @@ named "variable_impedance_controller" composing
 - "force_reference" (:class:`ForceReferenceSystem`): contact, penetration
   rate, F_ref, F_min, the FDCC target force,
 - "stiffness_qp" (:class:`StiffnessQpSystem`): K (QP or constant), D,
-  status, and the commit of its tick,
+  status, and the record of its tick ("qp_tick") the tank integrates,
 - "energy_tank" (:class:`EnergyTankSystem`): T, power, sigma, enabled,
 
 all at ``params.period_s`` (500 Hz by default). All four controllers (CS,
@@ -22,14 +22,16 @@ from pydrake.systems.framework import Diagram, DiagramBuilder
 from vic_drake.control.params import ControllerParams
 from vic_drake.errors import VicDrakeError
 from vic_drake.systems.references import ForceReferenceSystem
-from vic_drake.systems.stiffness_qp import STATUS_FIELDS, StiffnessQpSystem
+from vic_drake.systems.signals import STATUS_FIELDS, TANK_FIELDS
+from vic_drake.systems.stiffness_qp import StiffnessQpSystem
 from vic_drake.systems.tank import EnergyTankSystem
 from vic_drake.tissue.phantom import Phantom
 
-#: Fields of the "tank" output.
-TANK_FIELDS = ("T_J", "power_W", "sigma", "enabled")
-
-__all__ = ["MakeVariableImpedanceController", "STATUS_FIELDS", "TANK_FIELDS"]
+__all__ = [
+    "MakeVariableImpedanceController",
+    "STATUS_FIELDS",
+    "TANK_FIELDS",
+]
 
 
 def MakeVariableImpedanceController(
@@ -44,13 +46,12 @@ def MakeVariableImpedanceController(
 
     Returns:
         Diagram "variable_impedance_controller" with
-        inputs: "ee_position" (3, p_WP, m), "ee_velocity" (3, m/s),
-        "target_position" (3, x_d, m), "measured_force" (3, N, in W, sensor
-        convention: negative z = pressing);
+        inputs: "probe.position" (3, p_WP, m), "probe.velocity" (3, v_WP,
+        m/s), "target_position" (3, x_d, m), "ft_sensor.force_W" (3, N, in
+        W, sensor convention: negative z = pressing);
         outputs: "stiffness" (3, N/m), "damping" (3, N s/m), "target_force"
         (3, N), "force_reference" (3, N), "force_min" (3, N), "tank" (4:
-        T_J, power_W, sigma, enabled), "status" (6: qp_ok, fallback_count,
-        fault, in_contact, solve_time_s, penetration_m). All but
+        :data:`TANK_FIELDS`), "status" (6: :data:`STATUS_FIELDS`). All but
         "target_force" (direct feedthrough, read by the compliance stage in
         the same tick) describe the last tick (from state):
         force_reference and force_min are what that tick's QP used.
@@ -69,15 +70,15 @@ def MakeVariableImpedanceController(
     qp = builder.AddNamedSystem("stiffness_qp", StiffnessQpSystem(params))
     tank = builder.AddNamedSystem("energy_tank", EnergyTankSystem(params))
 
-    for name in ("ee_position", "ee_velocity"):
+    for name in ("probe.position", "probe.velocity"):
         index = builder.ExportInput(ref.GetInputPort(name), name)
         builder.ConnectInput(index, qp.GetInputPort(name))
     builder.ExportInput(qp.GetInputPort("target_position"), "target_position")
-    builder.ExportInput(ref.GetInputPort("measured_force"), "measured_force")
+    builder.ExportInput(ref.GetInputPort("ft_sensor.force_W"), "ft_sensor.force_W")
 
-    builder.Connect(ref.GetOutputPort("references"), qp.GetInputPort("references"))
+    builder.Connect(ref.get_references_output_port(), qp.GetInputPort("references"))
     builder.Connect(tank.get_energy_output_port(), qp.GetInputPort("tank_energy"))
-    builder.Connect(qp.get_commit_output_port(), tank.get_commit_input_port())
+    builder.Connect(qp.get_qp_tick_output_port(), tank.get_qp_tick_input_port())
 
     builder.ExportOutput(qp.get_stiffness_output_port(), "stiffness")
     builder.ExportOutput(qp.get_damping_output_port(), "damping")

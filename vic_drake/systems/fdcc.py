@@ -14,6 +14,7 @@ from pydrake.systems.framework import LeafSystem
 
 from vic_drake.control.fdcc import FdccModel, FdccParams, fdcc_step
 from vic_drake.errors import VicDrakeError
+from vic_drake.models.ur3e import MakeFdccModel
 
 
 class FdccController(LeafSystem):
@@ -40,13 +41,14 @@ class FdccController(LeafSystem):
     """
 
     def __init__(
-        self, params: FdccParams | None = None, *, station_params=None, initial_q=None
+        self, params: FdccParams | None = None, *, station_params, initial_q=None
     ):
         """
         Args:
             params: the FDCC settings (default FdccParams()).
             station_params: tool geometry (probe offset) of the internal
-                model; default StationParams().
+                model, a :class:`vic_drake.station.StationParams` (required:
+                this layer does not import the station).
             initial_q: default command, rad (6,); set it to the arm's start.
         """
         super().__init__()
@@ -55,7 +57,7 @@ class FdccController(LeafSystem):
             raise VicDrakeError(
                 f"params must be FdccParams, got {type(params).__name__}"
             )
-        self._model = FdccModel(self._params, station_params)
+        self._model = MakeFdccModel(self._params, station_params)
         self._R_WP_target = self._params.R_WP_target
         q0 = np.zeros(6) if initial_q is None else np.asarray(initial_q, float)
         if q0.shape != (6,) or not np.all(np.isfinite(q0)):

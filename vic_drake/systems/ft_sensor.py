@@ -41,10 +41,11 @@ from pydrake.multibody.tree import BodyIndex, JointIndex
 from pydrake.systems.framework import LeafSystem
 
 from vic_drake.errors import VicDrakeError
+from vic_drake.paper import GRAVITY_M_PER_S2
 
 
 def tared_sensor_wrench(
-    F_S, R_WS, *, distal_mass_kg: float, p_SScm, gravity_W=(0.0, 0.0, -9.81)
+    F_S, R_WS, *, distal_mass_kg: float, p_SScm, gravity_W=(0.0, 0.0, -GRAVITY_M_PER_S2)
 ) -> np.ndarray:
     """Removes the distal mass's static load from a sensor wrench.
 
@@ -102,7 +103,7 @@ class ForceTorqueSensor(LeafSystem):
         lag_samples: int = 0,
         noise_std=(0.0,) * 6,
         bias=(0.0,) * 6,
-        gravity_W=(0.0, 0.0, -9.81),
+        gravity_W=(0.0, 0.0, -GRAVITY_M_PER_S2),
     ):
         """
         Args:

@@ -1,4 +1,4 @@
-"""A bank of 1-DOF indenters palpating tissue: the palpation campaign's diagram.
+"""The 1-DOF indenter's systems and parameters: tissue, F/T sensor, palpation target.
 
 Each indenter is a body on a vertical prismatic joint of a discrete
 :class:`MultibodyPlant`, driven by the plant's implicit joint PD controller
@@ -14,12 +14,11 @@ sensor does. :class:`PalpationTarget` runs the procedure of the real rig:
 descend at constant speed until the measured force exceeds a threshold,
 record the height, then track a sinusoid a set depth below that height.
 
-Many indenters share one diagram (one joint each, every LeafSystem
-vectorised over them), so a whole campaign costs one simulation: the
-per-step Python overhead is paid once for all points, not once per point.
-Per-indenter data (surface height, kappa, lambda, start height) are numeric
-parameters in the Context, so one built diagram is reused for any batch of
-points by writing a fresh Context.
+Every LeafSystem here is vectorised over n indenters, so many indenters
+share one diagram (one joint each; the builder is
+:func:`vic_drake.experiments.indenter_bank.MakeIndenterDiagram`) and a whole
+campaign costs one simulation. Per-indenter data (surface height, kappa,
+lambda, start height) are numeric parameters in the Context.
 
 Force convention: every force here is positive when the body pushes the
 indenter up (minus the F/T sensor's z reading).
@@ -30,25 +29,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from pydrake.common import RandomDistribution, RandomGenerator
-from pydrake.multibody.plant import MultibodyPlant
-from pydrake.multibody.tree import (
-    PdControllerGains,
-    PrismaticJoint,
-    SpatialInertia,
-    UnitInertia,
-)
-from pydrake.systems.framework import BasicVector, Diagram, DiagramBuilder, LeafSystem
-from pydrake.systems.primitives import (
-    ConstantVectorSource,
-    LogVectorOutput,
-    RandomSource,
-)
+from pydrake.systems.framework import BasicVector, LeafSystem
 
 from vic_drake.errors import VicDrakeError
+from vic_drake.paper import CONTACT_THRESHOLD_N
 from vic_drake.tissue import hunt_crossley_force
-
-GRAVITY_M_PER_S2 = 9.81
 
 
 def _check_positive(owner: str, **values) -> None:
@@ -64,13 +49,10 @@ class IndenterParams:
     """The indenter and its position servo.
 
     The servo gains were identified from the real palpation logs
-    (``palpation/test_soft_{1,2,25}hz``): the real Cartesian controller held
-    the tip 8.4-9.9 mm deep under 5-6 N with a target 15 mm deep (a static
-    stiffness of about 1000 N/m against the tissue's), and the tip moved with
-    0.35, 0.16 and 0.12 of the target's 8 mm amplitude at 1, 2 and 2.5 Hz,
-    which a damping of about 400 N s/m reproduces. The real controller's
-    compliance keeps the penetration rate low, which keeps the fit in the
-    regime where the Hunt-Crossley force stays compressive.
+    (``palpation/test_soft_{1,2,25}hz``, see docs/decisions.md, "Indenter
+    servo gains"). The real controller's compliance keeps the penetration
+    rate low, which keeps the fit in the regime where the Hunt-Crossley
+    force stays compressive.
     """
 
     moving_mass_kg: float = 2.0  # Mass the servo moves (effective end-effector mass).
@@ -80,8 +62,7 @@ class IndenterParams:
     servo_stiffness_N_per_m: float = 1000.0  # Position gain of the joint PD servo.
     servo_damping_N_s_per_m: float = 400.0  # Velocity gain of the joint PD servo.
     # Discrete MultibodyPlant step. 2 ms (one step per sensor sample) halves
-    # the campaign's simulation time: on the 231-point measured campaign the
-    # fits moved from kappa 1.14 / lambda 2.69 % RMS error to 1.20 / 1.46 %.
+    # the campaign's simulation time; see docs/decisions.md, "Indenter time step".
     time_step_s: float = 0.001
 
     def __post_init__(self):
@@ -107,17 +88,15 @@ class SensorParams:
     """The F/T sensor model, from the real palpation logs.
 
     ``noise_std_N``: the std of the real z force about a Savitzky-Golay
-    smoothing (31 samples, cubic) in contact is 0.046 N in all three
-    palpation logs (0.041 N with an 11-sample window); the 32-37 free-air
-    samples before contact scatter by 0.06-0.09 N including the onset of
-    contact. ``lag_samples``: the real controller delayed the pose by 28
-    samples to align it with the force (data README), i.e. 56 ms at 500 Hz.
+    smoothing in contact (see docs/decisions.md, "Palpation sensor noise").
+    ``lag_samples``: the real controller delayed the pose by 28 samples to
+    align it with the force (data README), i.e. 56 ms at 500 Hz.
     """
 
     rate_hz: float = 500.0  # Sampling rate (the UR3e control rate).
     lag_samples: int = 28  # Force delay behind the pose, samples.
     noise_std_N: float = 0.045  # White Gaussian noise on the force, N.
-    bias_N: float = 0.0  # Constant tare error, N (the real logs: -0.35 to 0.08 N).
+    bias_N: float = 0.0  # Constant tare error, N (real logs: docs/decisions.md).
 
     def __post_init__(self):
         _check_positive("SensorParams", rate_hz=self.rate_hz)
@@ -149,9 +128,8 @@ class PalpationParams:
     duration_s: float = 5.0  # Palpation length after contact.
     start_clearance_m: float = 0.003  # Start height above the true surface.
     approach_speed_m_per_s: float = 0.02  # Descent speed before contact.
-    contact_threshold_N: float = (
-        0.5  # Measured force that ends the approach (real: 0.5 N).
-    )
+    # Measured force that ends the approach, N (the real controller's rule).
+    contact_threshold_N: float = CONTACT_THRESHOLD_N
     max_approach_s: float = 1.0  # Give-up time for the approach.
     # Feed the target velocity to the servo. The real Cartesian controller
     # did not (its damping acted on the tip velocity, see IndenterParams).
@@ -385,171 +363,13 @@ class PalpationTarget(LeafSystem):
         output.SetFromVector(np.concatenate([z_d, v_d]))
 
 
-@dataclass
-class IndenterBank:
-    """Handles of a built indenter diagram (see :func:`MakeIndenterDiagram`)."""
-
-    diagram: Diagram
-    plant: MultibodyPlant
-    tissue: HuntCrossleyIndentation
-    sensor: LaggedForceSensor
-    target: PalpationTarget
-    state_logger: object
-    force_logger: object
-    target_logger: object
-    contact_logger: object
-    n: int
-
-    def set_points(
-        self, root_context, *, surface_z, kappa, lam, start_z, seed=None
-    ) -> None:
-        """Writes the tissue and the start height of every indenter.
-
-        The indenters start at rest at ``start_z``; arrays of shape (n,).
-        With ``seed``, the sensor noise is reseeded first (this resets every
-        random state and parameter, hence it comes before the writes).
-        """
-        if seed is not None:
-            self.diagram.SetRandomContext(root_context, RandomGenerator(int(seed)))
-        self.tissue.set_tissue(
-            self.tissue.GetMyMutableContextFromRoot(root_context),
-            surface_z=surface_z,
-            kappa=kappa,
-            lam=lam,
-        )
-        self.target.set_start_z(
-            self.target.GetMyMutableContextFromRoot(root_context), start_z
-        )
-        plant_context = self.plant.GetMyMutableContextFromRoot(root_context)
-        self.plant.SetPositionsAndVelocities(
-            plant_context,
-            np.concatenate([np.broadcast_to(start_z, (self.n,)), np.zeros(self.n)]),
-        )
-
-
-def MakeIndenterDiagram(
-    n: int,
-    *,
-    beta: float,
-    indenter: IndenterParams | None = None,
-    sensor: SensorParams | None = None,
-    palpation: PalpationParams | None = None,
-) -> IndenterBank:
-    """Builds n servo-driven 1-DOF indenters palpating Hunt-Crossley tissue.
-
-    Args:
-        n: number of indenters (one prismatic joint each).
-        beta: Hunt-Crossley exponent of the tissue.
-        indenter, sensor, palpation: parameters (defaults as documented).
-
-    Returns:
-        An :class:`IndenterBank`; loggers sample at the sensor rate:
-        ``state_logger`` (2n: q, v), ``force_logger`` (n, measured force,
-        N), ``target_logger`` (2n: z_d, v_d), ``contact_logger`` (3n).
-    """
-    if int(n) != n or n < 1:
-        raise VicDrakeError(f"number of indenters must be an integer >= 1, got {n!r}")
-    n = int(n)
-    indenter = indenter or IndenterParams()
-    sensor = sensor or SensorParams()
-    palpation = palpation or PalpationParams()
-
-    builder = DiagramBuilder()
-    plant = builder.AddNamedSystem(
-        "plant", MultibodyPlant(time_step=indenter.time_step_s)
-    )
-    instance = plant.AddModelInstance("indenters")
-    inertia = SpatialInertia(
-        indenter.moving_mass_kg, np.zeros(3), UnitInertia.SolidSphere(0.02)
-    )
-    gains = PdControllerGains(
-        p=indenter.servo_stiffness_N_per_m, d=indenter.servo_damping_N_s_per_m
-    )
-    for i in range(n):
-        body = plant.AddRigidBody(f"indenter_{i}", instance, inertia)
-        joint = plant.AddJoint(
-            PrismaticJoint(
-                f"indenter_{i}_z",
-                plant.world_frame(),
-                body.body_frame(),
-                [0.0, 0.0, 1.0],
-            )
-        )
-        actuator = plant.AddJointActuator(f"indenter_{i}_servo", joint)
-        actuator.set_controller_gains(gains)
-    plant.Finalize()
-
-    tissue = builder.AddNamedSystem("tissue", HuntCrossleyIndentation(n, beta))
-    force_sensor = builder.AddNamedSystem(
-        "ft_sensor",
-        LaggedForceSensor(n, sensor, indenter_mass_kg=indenter.indenter_mass_kg),
-    )
-    noise = builder.AddNamedSystem(
-        "sensor_noise", RandomSource(RandomDistribution.kGaussian, n, sensor.period_s)
-    )
-    target = builder.AddNamedSystem(
-        "palpation_target", PalpationTarget(n, palpation, period_s=sensor.period_s)
-    )
-    gravity_compensation = builder.AddNamedSystem(
-        "gravity_compensation",
-        ConstantVectorSource(np.full(n, indenter.moving_mass_kg * GRAVITY_M_PER_S2)),
-    )
-
-    state_port = plant.get_state_output_port(instance)
-    builder.Connect(state_port, tissue.get_indenter_state_input_port())
-    builder.Connect(
-        tissue.get_generalized_force_output_port(),
-        plant.get_applied_generalized_force_input_port(),
-    )
-    builder.Connect(
-        tissue.get_generalized_force_output_port(),
-        force_sensor.GetInputPort("tissue_force"),
-    )
-    builder.Connect(
-        plant.get_generalized_acceleration_output_port(instance),
-        force_sensor.GetInputPort("acceleration"),
-    )
-    builder.Connect(noise.get_output_port(0), force_sensor.GetInputPort("noise"))
-    builder.Connect(
-        force_sensor.get_measured_force_output_port(),
-        target.GetInputPort("measured_force"),
-    )
-    builder.Connect(state_port, target.GetInputPort("indenter_state"))
-    builder.Connect(
-        target.get_desired_state_output_port(),
-        plant.get_desired_state_input_port(instance),
-    )
-    builder.Connect(
-        gravity_compensation.get_output_port(), plant.get_actuation_input_port(instance)
-    )
-
-    period = sensor.period_s
-    state_logger = LogVectorOutput(state_port, builder, period)
-    force_logger = LogVectorOutput(
-        force_sensor.get_measured_force_output_port(), builder, period
-    )
-    target_logger = LogVectorOutput(
-        target.get_desired_state_output_port(), builder, period
-    )
-    contact_logger = LogVectorOutput(target.get_contact_output_port(), builder, period)
-    for logger, name in (
-        (state_logger, "state_logger"),
-        (force_logger, "force_logger"),
-        (target_logger, "target_logger"),
-        (contact_logger, "contact_logger"),
-    ):
-        logger.set_name(name)
-    diagram = builder.Build()
-    diagram.set_name("indenter_bank")
-    return IndenterBank(
-        diagram=diagram,
-        plant=plant,
-        tissue=tissue,
-        sensor=force_sensor,
-        target=target,
-        state_logger=state_logger,
-        force_logger=force_logger,
-        target_logger=target_logger,
-        contact_logger=contact_logger,
-        n=n,
-    )
+__all__ = [
+    "HuntCrossleyIndentation",
+    "IndenterParams",
+    "LaggedForceSensor",
+    "PalpationParams",
+    "PalpationTarget",
+    "SensorParams",
+    "palpation_target",
+    "sensed_force",
+]

@@ -8,7 +8,9 @@ and the QP and FDCC read them within the same tick). The periodic discrete
 update at the controller rate advances the surface-velocity filter and
 stores the tick's values, which the "force_reference", "force_min" and
 "contact" ports publish from state: what the QP used at the last tick
-(loggers read them after the tick's update without recomputing).
+(loggers read them after the tick's update without recomputing). The
+packed "references" and "contact" layouts are in
+:mod:`vic_drake.systems.signals`.
 """
 
 from __future__ import annotations
@@ -31,6 +33,17 @@ from vic_drake.control.references import (
     surface_velocity_initial_state,
     surface_velocity_step,
 )
+from vic_drake.systems.signals import (
+    REF_CONTACT,
+    REF_FAULT,
+    REF_FORCE_MIN,
+    REF_FORCE_REFERENCE,
+    REF_IN_CONTACT,
+    REF_PENETRATION,
+    REF_SURFACE_VELOCITY,
+    REF_TARGET_FORCE,
+    REFERENCES_SIZE,
+)
 from vic_drake.tissue.phantom import Phantom
 
 
@@ -38,20 +51,21 @@ class ForceReferenceSystem(LeafSystem):
     """Force references of the selected controller (CS, CF, VS-CF, VS-VF).
 
     Input ports:
-        ee_position (3): probe tip p_WP, m.
-        ee_velocity (3): v_WP, m/s.
-        measured_force (3): F/T force in W, N, sensor convention.
+        probe.position (3): probe tip p_WP, m.
+        probe.velocity (3): v_WP, m/s.
+        ft_sensor.force_W (3): F/T force in W, N, sensor convention.
 
     Output ports (direct feedthrough of the current inputs):
         target_force (3): force the FDCC stage tracks, N (CF only).
-        references (13): [F_ref (3), F_min (3), target force (3), contact
-            (4)] (see below), read by StiffnessQpSystem in one port
+        references (13): F_ref, F_min, target force, contact (layout
+            :data:`vic_drake.systems.signals.REFERENCES_SIZE` and the
+            ``REF_*`` slices), read by StiffnessQpSystem in one port
             evaluation.
     Output ports (state: the values of the last tick):
         force_reference (3): F_ref, N (sensor convention).
         force_min (3): F_min, N.
-        contact (4): [in_contact (0/1), penetration_m, fault (0/1),
-            surface_velocity_m_per_s].
+        contact (4): :data:`vic_drake.systems.signals.CONTACT_FIELDS`
+            (in_contact, penetration_m, fault, surface_velocity_m_per_s).
 
     State: the surface-velocity filter and the last tick's F_ref, F_min,
     contact (discrete, updated every period).
@@ -70,9 +84,9 @@ class ForceReferenceSystem(LeafSystem):
         self._dt = float(params.period_s)
         ref = params.reference
         self._mode = ref.surface_velocity_mode
-        self._position_port = self.DeclareVectorInputPort("ee_position", 3)
-        self._velocity_port = self.DeclareVectorInputPort("ee_velocity", 3)
-        self._force_port = self.DeclareVectorInputPort("measured_force", 3)
+        self._position_port = self.DeclareVectorInputPort("probe.position", 3)
+        self._velocity_port = self.DeclareVectorInputPort("probe.velocity", 3)
+        self._force_port = self.DeclareVectorInputPort("ft_sensor.force_W", 3)
         self._filter_index = self.DeclareDiscreteState(
             surface_velocity_initial_state(ref.surface_velocity_window)
         )
@@ -85,30 +99,45 @@ class ForceReferenceSystem(LeafSystem):
             {self.all_input_ports_ticket(), self.xd_ticket()},
         )
         self._outputs = {}
-        for name, size, start in (("target_force", 3, 6), ("references", 13, 0)):
+        for name, part in (
+            ("target_force", REF_TARGET_FORCE),
+            ("references", slice(0, REFERENCES_SIZE)),
+        ):
             self._outputs[name] = self.DeclareVectorOutputPort(
                 name,
-                size,
-                self._make_output(start, size),
+                part.stop - part.start,
+                self._make_output(part),
                 {self._cache.ticket()},
             )
         self._last = {}
-        for name, size, start in (
-            ("force_reference", 3, 0),
-            ("force_min", 3, 3),
-            ("contact", 4, 9),
+        for name, part in (
+            ("force_reference", REF_FORCE_REFERENCE),
+            ("force_min", REF_FORCE_MIN),
+            ("contact", REF_CONTACT),
         ):
-            self._last[name] = (self.DeclareDiscreteState(size), start, size)
+            self._last[name] = (self.DeclareDiscreteState(part.stop - part.start), part)
             self._outputs[name] = self.DeclareStateOutputPort(name, self._last[name][0])
 
-    def _make_output(self, start: int, size: int):
+    def _make_output(self, part: slice):
         def calc(context, output: BasicVector):
-            output.SetFromVector(self._cache.Eval(context)[0][start : start + size])
+            output.SetFromVector(self._cache.Eval(context)[0][part])
 
         return calc
 
+    def _safe_values(self) -> np.ndarray:
+        """The references of a faulty tick: zero F_ref, F_min,z = -F_max,z, fault."""
+        qp = self._params.qp
+        values = np.zeros(REFERENCES_SIZE)
+        values[REF_FORCE_MIN] = (
+            qp.force_min_N[0],
+            qp.force_min_N[1],
+            -qp.force_max_N[2],
+        )
+        values[REF_FAULT] = 1.0
+        return values
+
     def _evaluate(self, context):
-        """(values (13,), new filter state) for the current inputs."""
+        """(values (REFERENCES_SIZE,), new filter state) for the current inputs."""
         p_WP = self._position_port.Eval(context).tolist()
         v_WP = self._velocity_port.Eval(context).tolist()
         f_W = self._force_port.Eval(context).tolist()
@@ -116,12 +145,9 @@ class ForceReferenceSystem(LeafSystem):
         ref, qp = self._params.reference, self._params.qp
         # A sum of floats is finite iff every term is (inf - inf = nan).
         if not math.isfinite(sum(p_WP) + sum(v_WP) + sum(f_W)):
-            values = np.zeros(13)
-            values[3:6] = (qp.force_min_N[0], qp.force_min_N[1], -qp.force_max_N[2])
-            values[11] = 1.0
             # Restart the filter: the next good sample only records its height
             # (no rate spike across the gap).
-            return values, [0.0, *filt[1:]]
+            return self._safe_values(), [0.0, *filt[1:]]
         surface_z, dz_dx, dz_dy, kappa, lam = self._sample(p_WP[0], p_WP[1])
         if self._mode == "moving_average":
             new_filt, z_surf_dot = surface_velocity_step(filt, surface_z, self._dt)
@@ -138,35 +164,31 @@ class ForceReferenceSystem(LeafSystem):
             ref=ref,
             qp=qp,
         )
-        values = [
-            *refs.force_ref,
-            *refs.force_min,
-            *refs.target_force,
-            1.0 if contact else 0.0,
-            penetration(surface_z, p_WP[2]),
-            0.0,
-            z_surf_dot,
-        ]
+        values = [0.0] * REFERENCES_SIZE  # A list: cheaper than numpy per element.
+        values[REF_FORCE_REFERENCE] = refs.force_ref
+        values[REF_FORCE_MIN] = refs.force_min
+        values[REF_TARGET_FORCE] = refs.target_force
+        values[REF_IN_CONTACT] = 1.0 if contact else 0.0
+        values[REF_PENETRATION] = penetration(surface_z, p_WP[2])
+        values[REF_FAULT] = 0.0
+        values[REF_SURFACE_VELOCITY] = z_surf_dot
         if not math.isfinite(sum(values)):  # E.g. a phantom returning NaN.
-            values = [0.0] * 13
-            values[3:6] = (qp.force_min_N[0], qp.force_min_N[1], -qp.force_max_N[2])
-            values[11] = 1.0
-        values = np.array(values)
-        return values, new_filt
+            return self._safe_values(), new_filt
+        return np.array(values), new_filt
 
     def _calc(self, context, value):
         value.set_value(self._evaluate(context))
 
     def _update(self, context, discrete_state):
         values, new_filt = self._cache.Eval(context)
-        discrete_state.get_mutable_vector(self._filter_index).SetFromVector(new_filt)
-        for index, start, size in self._last.values():
-            discrete_state.set_value(index, values[start : start + size])
+        discrete_state.set_value(self._filter_index, new_filt)
+        for index, part in self._last.values():
+            discrete_state.set_value(index, values[part])
 
-    def get_ee_position_input_port(self):
+    def get_probe_position_input_port(self):
         return self._position_port
 
-    def get_ee_velocity_input_port(self):
+    def get_probe_velocity_input_port(self):
         return self._velocity_port
 
     def get_measured_force_input_port(self):
@@ -183,3 +205,6 @@ class ForceReferenceSystem(LeafSystem):
 
     def get_contact_output_port(self):
         return self._outputs["contact"]
+
+    def get_references_output_port(self):
+        return self._outputs["references"]

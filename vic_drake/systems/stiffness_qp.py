@@ -2,10 +2,11 @@
 
 A thin wrapper over :mod:`vic_drake.control.stiffness_qp`: every period it
 reads the measurement, the references and the tank energy, solves the QP
-(or, for CS and CF, applies their constant stiffness) and stores the
-stiffness, the inputs it used (the "commit" the tank integrates, see
-:mod:`vic_drake.systems.tank`) and a status record in its discrete state.
-Output ports only read that state; no solve happens in an output.
+(or, for CS and CF, applies their constant stiffness) and stores in its
+discrete state the stiffness, the damping, what the tick used for the tank
+to integrate (the "qp_tick" record; see :mod:`vic_drake.systems.tank`) and
+a status record. Each is published by a state output port; no solve
+happens in an output.
 """
 
 from __future__ import annotations
@@ -18,42 +19,55 @@ from pydrake.systems.framework import LeafSystem
 
 from vic_drake.control.params import ControllerParams
 from vic_drake.control.references import constant_stiffness
-from vic_drake.control.stiffness_qp import StiffnessQp, make_stiffness_qp_problem
-from vic_drake.systems.tank import COMMIT_SIZE
-
-#: Layout of the "status" output (and state group).
-STATUS_FIELDS = (
-    "qp_ok",
-    "fallback_count",
-    "fault",
-    "in_contact",
-    "solve_time_s",
-    "penetration_m",
+from vic_drake.control.stiffness_qp.problem import make_stiffness_qp_problem
+from vic_drake.control.stiffness_qp.program import StiffnessQp
+from vic_drake.systems.signals import (
+    QP_TICK_ACTIVE,
+    QP_TICK_DAMPING_USED,
+    QP_TICK_POSITION_ERROR,
+    QP_TICK_SIZE,
+    QP_TICK_STIFFNESS,
+    QP_TICK_VELOCITY_ERROR,
+    REF_FAULT,
+    REF_FORCE_MIN,
+    REF_FORCE_REFERENCE,
+    REF_IN_CONTACT,
+    REF_PENETRATION,
+    REFERENCES_SIZE,
+    STATUS_FALLBACK_COUNT,
+    STATUS_FIELDS,
+    STATUS_QP_OK,
 )
+
+__all__ = ["STATUS_FIELDS", "StiffnessQpSystem"]
 
 
 class StiffnessQpSystem(LeafSystem):
     """Diagonal stiffness from the QP of eq. 8 (or CS/CF's constant one).
 
     Input ports:
-        ee_position (3): p_WP, m.
-        ee_velocity (3): v_WP, m/s.
+        probe.position (3): p_WP, m.
+        probe.velocity (3): v_WP, m/s.
         target_position (3): x_d, m.
-        references (13): ForceReferenceSystem's "references": [F_ref (3, N),
-            F_min (3, N), target force (3, N), in_contact, penetration_m,
-            fault, surface_velocity_m_per_s].
-        tank_energy (1): T before this tick, J (EnergyTankSystem "energy").
+        references (13): ForceReferenceSystem's "references" (F_ref, F_min,
+            target force, contact; layout in :mod:`vic_drake.systems.signals`).
+        tank_energy (1): T before this tick, J (EnergyTankSystem's
+            "tank_energy").
 
-    Output ports:
+    Output ports (the last tick, from state):
         stiffness (3): K, N/m.
         damping (3): D = 2 zeta sqrt(K), N s/m (what the next tick's QP
             and the compliance stage use).
-        commit (14): [e, e_dot, K, D_used, dt, active] of the last tick.
-        status (6): [qp_ok, fallback_count, fault, in_contact,
-            solve_time_s, penetration_m].
+        qp_tick (13): what the tick used, for the tank: e = x_d - x,
+            e_dot = -x_dot (both 0 on CS, CF and faulty ticks), K, the
+            damping used, active (layout: the ``QP_TICK_*`` slices of
+            :mod:`vic_drake.systems.signals`).
+        status (6): :data:`vic_drake.systems.signals.STATUS_FIELDS`
+            (qp_ok, fallback_count, fault, in_contact, solve_time_s,
+            penetration_m).
 
-    State (discrete): commit (14), status (6), K (3) and D (3), all
-    published as they are. K starts at K_min (constant stiffness for CS/CF).
+    State (discrete): one group per output port, published as it is. K
+    starts at K_min (constant stiffness for CS/CF).
 
     Fallbacks: a failed or infeasible solve, or a non-finite input (fault),
     gives K = K_min, qp_ok = 0 and increments fallback_count. With the tank
@@ -79,46 +93,46 @@ class StiffnessQpSystem(LeafSystem):
         )
         ports = {}
         for name, size in (
-            ("ee_position", 3),
-            ("ee_velocity", 3),
+            ("probe.position", 3),
+            ("probe.velocity", 3),
             ("target_position", 3),
-            ("references", 13),
+            ("references", REFERENCES_SIZE),
             ("tank_energy", 1),
         ):
             ports[name] = self.DeclareVectorInputPort(name, size)
         self._in = ports
         k0 = self._constant if self._constant is not None else self._k_min
-        commit0 = np.zeros(COMMIT_SIZE)
-        commit0[6:9] = k0
-        commit0[9:12] = [2.0 * self._zeta * math.sqrt(k) for k in k0]
-        self._commit_index = self.DeclareDiscreteState(commit0)
-        self._status_index = self.DeclareDiscreteState(
-            np.array([1.0, 0.0, 0.0, 0.0, 0.0, 0.0])
-        )
-        # K and D again, each its own group so the ports publish state (no
-        # Python per evaluation).
-        self._stiffness_index = self.DeclareDiscreteState(commit0[6:9])
-        self._damping_index = self.DeclareDiscreteState(commit0[9:12])
+        d0 = [2.0 * self._zeta * math.sqrt(k) for k in k0]
+        status0 = np.zeros(len(STATUS_FIELDS))
+        status0[STATUS_QP_OK] = 1.0
+        self._index = {}
+        self._out = {}
+        tick0 = np.zeros(QP_TICK_SIZE)  # No tick yet: not active.
+        tick0[QP_TICK_STIFFNESS] = k0
+        tick0[QP_TICK_DAMPING_USED] = d0
+        for name, value in (
+            ("stiffness", k0),
+            ("damping", d0),
+            ("qp_tick", tick0),
+            ("status", status0),
+        ):
+            self._index[name] = self.DeclareDiscreteState(np.asarray(value, float))
+            self._out[name] = self.DeclareStateOutputPort(name, self._index[name])
         self.DeclarePeriodicDiscreteUpdateEvent(self._dt, 0.0, self._update)
-        self._stiffness_port = self.DeclareStateOutputPort(
-            "stiffness", self._stiffness_index
-        )
-        self._damping_port = self.DeclareStateOutputPort("damping", self._damping_index)
-        self._commit_port = self.DeclareStateOutputPort("commit", self._commit_index)
-        self._status_port = self.DeclareStateOutputPort("status", self._status_index)
 
     def _update(self, context, discrete_state):
-        inp = self._in
-        p_WP = inp["ee_position"].Eval(context).tolist()
-        v_WP = inp["ee_velocity"].Eval(context).tolist()
+        inp, index = self._in, self._index
+        p_WP = inp["probe.position"].Eval(context).tolist()
+        v_WP = inp["probe.velocity"].Eval(context).tolist()
         x_d = inp["target_position"].Eval(context).tolist()
         refs = inp["references"].Eval(context).tolist()
         energy = float(inp["tank_energy"].Eval(context)[0])
-        commit_old = context.get_discrete_state(self._commit_index).value().tolist()
-        count = context.get_discrete_state(self._status_index).GetAtIndex(1)
-        f_ref, f_min = refs[0:3], refs[3:6]
+        k_prev = context.get_discrete_state(index["stiffness"]).value().tolist()
+        count = context.get_discrete_state(index["status"]).GetAtIndex(
+            STATUS_FALLBACK_COUNT
+        )
+        f_ref, f_min = refs[REF_FORCE_REFERENCE], refs[REF_FORCE_MIN]
         zeta = self._zeta
-        k_prev = commit_old[6:9]
         d_used = (
             2.0 * zeta * math.sqrt(max(k_prev[0], 0.0)),
             2.0 * zeta * math.sqrt(max(k_prev[1], 0.0)),
@@ -126,7 +140,7 @@ class StiffnessQpSystem(LeafSystem):
         )
         # A sum of floats is finite iff every term is (inf - inf = nan).
         total = sum(p_WP) + sum(v_WP) + sum(x_d) + sum(refs) + energy
-        fault = not math.isfinite(total) or refs[11] > 0.5
+        fault = not math.isfinite(total) or refs[REF_FAULT] > 0.5
         e = (0.0, 0.0, 0.0)
         e_dot = (0.0, 0.0, 0.0)
         qp_ok, solve_time = 1.0, 0.0
@@ -153,27 +167,34 @@ class StiffnessQpSystem(LeafSystem):
                 if not sol.success:
                     qp_ok = 0.0
                     count += 1.0
-        commit = discrete_state.get_mutable_vector(self._commit_index)
-        commit.SetFromVector([*e, *e_dot, *k, *d_used, self._dt, active])
-        discrete_state.get_mutable_vector(self._stiffness_index).SetFromVector(k)
-        discrete_state.get_mutable_vector(self._damping_index).SetFromVector(
-            [2.0 * zeta * math.sqrt(max(k_i, 0.0)) for k_i in k]
-        )
-        status = discrete_state.get_mutable_vector(self._status_index)
-        in_contact = 0.0 if fault else refs[9]
-        pen = refs[10] if math.isfinite(refs[10]) else 0.0
-        status.SetFromVector(
-            [qp_ok, count, 1.0 if fault else 0.0, in_contact, solve_time, pen]
-        )
+        tick = [0.0] * QP_TICK_SIZE
+        tick[QP_TICK_POSITION_ERROR] = e
+        tick[QP_TICK_VELOCITY_ERROR] = e_dot
+        tick[QP_TICK_STIFFNESS] = k
+        tick[QP_TICK_DAMPING_USED] = d_used
+        tick[QP_TICK_ACTIVE] = active
+        in_contact = 0.0 if fault else refs[REF_IN_CONTACT]
+        pen = refs[REF_PENETRATION] if math.isfinite(refs[REF_PENETRATION]) else 0.0
+        for name, value in (
+            ("stiffness", k),
+            ("damping", [2.0 * zeta * math.sqrt(max(k_i, 0.0)) for k_i in k]),
+            ("qp_tick", tick),
+            # In the order of STATUS_FIELDS.
+            (
+                "status",
+                [qp_ok, count, 1.0 if fault else 0.0, in_contact, solve_time, pen],
+            ),
+        ):
+            discrete_state.set_value(index[name], value)
 
     def get_stiffness_output_port(self):
-        return self._stiffness_port
+        return self._out["stiffness"]
 
     def get_damping_output_port(self):
-        return self._damping_port
+        return self._out["damping"]
 
-    def get_commit_output_port(self):
-        return self._commit_port
+    def get_qp_tick_output_port(self):
+        return self._out["qp_tick"]
 
     def get_status_output_port(self):
-        return self._status_port
+        return self._out["status"]

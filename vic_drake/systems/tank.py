@@ -3,11 +3,12 @@
 The tank and the stiffness QP are coupled inside one tick: the QP at tick n
 uses T after tick n-1, and the tank at tick n integrates the power of the
 stiffness the QP chose at tick n. Drake's simultaneous discrete updates
-cannot chain two systems within a tick, so the QP system publishes, in its
-state, the "commit" of its last tick (e, e_dot, K, D, dt, active) and the
-tank's outputs are T_state advanced by that commit (cheap algebra, no
-solve). The periodic update then stores that value. Both systems thus see
-exactly the sequence of the real controller, with no lag.
+cannot chain two systems within a tick, so the QP system publishes, from
+its state, what its last tick used (its "qp_tick" record: position error,
+velocity error, stiffness, damping, active) and the tank's outputs are
+T_state advanced by that tick (cheap algebra, no solve). The periodic update then stores that value.
+Both systems thus see exactly the sequence of the real controller, with no
+lag.
 """
 
 from __future__ import annotations
@@ -23,29 +24,38 @@ from vic_drake.control.tank import (
     tank_state,
     tank_step,
 )
+from vic_drake.systems.signals import (
+    QP_TICK_ACTIVE,
+    QP_TICK_DAMPING_USED,
+    QP_TICK_POSITION_ERROR,
+    QP_TICK_SIZE,
+    QP_TICK_STIFFNESS,
+    QP_TICK_VELOCITY_ERROR,
+    TANK_ENERGY,
+    TANK_FIELDS,
+)
 
-#: Layout of the QP system's "commit" vector read by the tank.
-COMMIT_SIZE = 14
-COMMIT_E = slice(0, 3)
-COMMIT_E_DOT = slice(3, 6)
-COMMIT_K = slice(6, 9)
-COMMIT_D = slice(9, 12)
-COMMIT_DT = 12
-COMMIT_ACTIVE = 13
+__all__ = ["EnergyTankSystem", "TANK_FIELDS"]
 
 
 class EnergyTankSystem(LeafSystem):
     """Energy tank x_t (T = x_t^2 / 2), updated at the controller rate.
 
     Input ports:
-        commit (14): [e (3, m), e_dot (3, m/s), K (3, N/m), D (3, N s/m),
-            dt (s), active (0/1)] of the stiffness QP's last tick.
+        qp_tick (13): StiffnessQpSystem's record of its last tick: e
+            (m), e_dot (m/s), K (N/m), the damping used (N s/m), active
+            (layout: the ``QP_TICK_*`` slices of
+            :mod:`vic_drake.systems.signals`). On an inactive tick (before
+            the QP's first, CS and CF): power 0, sigma 0, enabled 0, T
+            constant.
+
+    The tick lasts ``params.period_s``.
 
     Output ports:
-        tank (4): [T_J, power_W, sigma, enabled] after the committed tick
-            (power 0, sigma 0, enabled 0 when the tick was inactive: CS, CF).
-        energy (1): T_J, what the next QP tick sees.
-        x_t (1): the tank state (before the committed tick).
+        tank (4): :data:`vic_drake.systems.signals.TANK_FIELDS` (T_J,
+            power_W, sigma, enabled) after the QP's last tick.
+        tank_energy (1): T_J, what the next QP tick sees.
+        x_t (1): the tank state (before the QP's last tick).
 
     State: x_t (1), discrete.
     """
@@ -57,7 +67,8 @@ class EnergyTankSystem(LeafSystem):
         params = copy.deepcopy(params).validate()
         self._tank = params.tank
         self._k_min = tuple(params.qp.stiffness_min_N_per_m)
-        self._commit_port = self.DeclareVectorInputPort("commit", COMMIT_SIZE)
+        self._dt = float(params.period_s)
+        self._tick_port = self.DeclareVectorInputPort("qp_tick", QP_TICK_SIZE)
         self._state_index = self.DeclareDiscreteState(
             [tank_state(params.tank.initial_energy_J)]
         )
@@ -65,12 +76,12 @@ class EnergyTankSystem(LeafSystem):
         self.DeclareStateOutputPort("x_t", self._state_index)
         self._tank_port = self.DeclareVectorOutputPort(
             "tank",
-            4,
+            len(TANK_FIELDS),
             self._calc_tank,
             {self.xd_ticket(), self.all_input_ports_ticket()},
         )
         self._energy_port = self.DeclareVectorOutputPort(
-            "energy",
+            "tank_energy",
             1,
             self._calc_energy,
             {self.xd_ticket(), self.all_input_ports_ticket()},
@@ -80,31 +91,40 @@ class EnergyTankSystem(LeafSystem):
         energy = tank_energy(
             context.get_discrete_state(self._state_index).GetAtIndex(0)
         )
-        c = self._commit_port.Eval(context).tolist()
-        if c[COMMIT_ACTIVE] < 0.5:
+        tick = self._tick_port.Eval(context).tolist()
+        if tick[QP_TICK_ACTIVE] < 0.5:
             return TankStep(energy, 0.0, 0.0, False)
         return tank_step(
-            energy, c[COMMIT_E], c[COMMIT_E_DOT], c[COMMIT_K], self._k_min, c[COMMIT_D],
-            c[COMMIT_DT], self._tank,
-        )  # fmt: skip
+            energy,
+            tick[QP_TICK_POSITION_ERROR],
+            tick[QP_TICK_VELOCITY_ERROR],
+            tick[QP_TICK_STIFFNESS],
+            self._k_min,
+            tick[QP_TICK_DAMPING_USED],
+            self._dt,
+            self._tank,
+        )
 
     def _calc_tank(self, context, output: BasicVector):
         s = self._step(context)
+        # In the order of TANK_FIELDS.
         output.SetFromVector(
             [s.energy_J, s.power_W, s.sigma, 1.0 if s.enabled else 0.0]
         )
 
-    # "energy" and the update read the cached "tank" output: one tank step per tick.
+    # "tank_energy" and the update read the cached "tank" output: one tank
+    # step per tick.
     def _calc_energy(self, context, output: BasicVector):
-        output.SetAtIndex(0, self._tank_port.Eval(context)[0])
+        output.SetAtIndex(0, self._tank_port.Eval(context)[TANK_ENERGY])
 
     def _update(self, context, discrete_state):
-        discrete_state.get_mutable_vector(self._state_index).SetAtIndex(
-            0, tank_state(float(self._tank_port.Eval(context)[0]))
+        discrete_state.set_value(
+            self._state_index,
+            [tank_state(float(self._tank_port.Eval(context)[TANK_ENERGY]))],
         )
 
-    def get_commit_input_port(self):
-        return self._commit_port
+    def get_qp_tick_input_port(self):
+        return self._tick_port
 
     def get_tank_output_port(self):
         return self._tank_port

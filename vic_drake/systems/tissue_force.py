@@ -25,15 +25,15 @@ Geometry and signs (all in the world frame W = the rig's ``base_link``):
   vertical force, as in the paper's 1-D model. Two horizontal terms, on in
   the station's defaults (``StationParams.tissue_force_along_normal``,
   ``tissue_friction_coefficient``), add what the real scans' lateral sensor
-  forces show (:func:`vic_drake.metrics.estimate_tissue_friction`): the
-  force tilted along the surface normal, ``F (-dz/dx, -dz/dy, 1)`` (the real
-  logs' lateral forces follow 0.82-1.04 times that tilt), and a regularised
-  sliding friction ``-mu F v_t / sqrt(|v_t|^2 + v_s^2)`` (mu 0.22-0.30 in
-  the real logs). The element's own defaults are the paper's vertical model.
+  forces show (:func:`vic_drake.analysis.identification.estimate_tissue_friction`; see
+  docs/decisions.md, "Lateral tissue forces"): the force tilted along the
+  surface normal, ``F (-dz/dx, -dz/dy, 1)``, and a regularised sliding
+  friction ``-mu F v_t / sqrt(|v_t|^2 + v_s^2)``. The element's own
+  defaults are the paper's vertical model.
 
   Note on the real logs' sensor x, y columns: they are the external force in
   the sensor frame S (tool pointing down: x_S = x_W, y_S = -y_W, z_S =
-  -z_W); :func:`vic_drake.metrics.real_to_canonical` turns them into the
+  -z_W); :func:`vic_drake.analysis.columns.real_to_canonical` turns them into the
   canonical reading, minus the external force in W, by negating x.
 """
 
@@ -180,7 +180,7 @@ def tip_contact(
 
 
 def _cross(a, b) -> np.ndarray:
-    """a x b for 3-vectors (np.cross costs ~50 us per call; this runs each step)."""
+    """a x b for 3-vectors (cheaper than np.cross at this size; this runs each step)."""
     return np.array(
         [
             a[1] * b[2] - a[2] * b[1],
@@ -200,14 +200,14 @@ class TissueForceElement(LeafSystem):
         spatial_forces: ``list[ExternallyAppliedSpatialForce]`` -- +F on the
             indenter at the tip, -F on the phantom body; connect to the
             plant's applied spatial force input.
-        force_W: (3,) true tissue force on the tip in W, N (z >= 0 up, the
-            Hunt-Crossley law; x, y the optional normal tilt and friction,
-            else 0).
-        penetration: (1,) eps, m.
-        surface_z: (1,) tissue surface height under the tip in W, m.
-        tip_position: (3,) p_WT, m, and tip_velocity: (3,) v_WT, m/s (the
-            probe tip's kinematics, computed here anyway: the station
-            exports them as ``probe.position`` and ``probe.velocity``).
+        tissue.force_W: (3,) true tissue force on the tip in W, N (z >= 0
+            up, the Hunt-Crossley law; x, y the optional normal tilt and
+            friction, else 0).
+        tissue.penetration: (1,) eps, m.
+        tissue.surface_z: (1,) tissue surface height under the tip in W, m.
+        probe.position: (3,) p_WT, m, and probe.velocity: (3,) v_WT, m/s
+            (the probe tip's kinematics, computed here anyway; the station
+            exports them under the same names).
 
     Outputs depend on the plant's state only (no direct feedthrough from
     the applied-force input), so the loop through the plant is not algebraic.
@@ -294,32 +294,32 @@ class TissueForceElement(LeafSystem):
             prerequisites_of_calc={self._contact_cache.ticket()},
         )
         self._force_port = self.DeclareVectorOutputPort(
-            "force_W",
+            "tissue.force_W",
             3,
             self._calc_force,
             prerequisites_of_calc={self._contact_cache.ticket()},
         )
         self._penetration_port = self.DeclareVectorOutputPort(
-            "penetration",
+            "tissue.penetration",
             1,
             lambda c, out: out.SetAtIndex(0, self._contact(c).penetration_m),
             prerequisites_of_calc={self._contact_cache.ticket()},
         )
         self._surface_port = self.DeclareVectorOutputPort(
-            "surface_z",
+            "tissue.surface_z",
             1,
             lambda c, out: out.SetAtIndex(0, self._contact(c).surface_z_m),
             prerequisites_of_calc={self._contact_cache.ticket()},
         )
 
         self._tip_position_port = self.DeclareVectorOutputPort(
-            "tip_position",
+            "probe.position",
             3,
             lambda c, out: out.SetFromVector(self._contact_cache.Eval(c).p_WT),
             prerequisites_of_calc={self._contact_cache.ticket()},
         )
         self._tip_velocity_port = self.DeclareVectorOutputPort(
-            "tip_velocity",
+            "probe.velocity",
             3,
             lambda c, out: out.SetFromVector(self._contact_cache.Eval(c).v_WT),
             prerequisites_of_calc={self._contact_cache.ticket()},

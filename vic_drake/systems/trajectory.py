@@ -10,19 +10,37 @@ them as ports:
 - :class:`PhantomLiftSource`: output "phantom_lift" (1, m), the vertical
   offset of the phantom (0 in nominal runs).
 
-Both are stateless functions of time.
+Both are stateless functions of time. The configurations are
+:class:`vic_drake.scenario.TrajectoryConfig` and
+:class:`vic_drake.scenario.DisturbanceConfig`; the scenario layer sits above
+this one, so they are read by their fields (checked here), not imported.
 """
 
 from __future__ import annotations
 
 import numpy as np
 from pydrake.systems.framework import BasicVector, LeafSystem
+from pydrake.trajectories import PiecewisePolynomial
 
 from vic_drake.errors import VicDrakeError
-from vic_drake.scenario import DisturbanceConfig, TrajectoryConfig
+
+#: The fields of a TrajectoryConfig that the target reads.
+_TRAJECTORY_FIELDS = (
+    "waypoints", "start_x_m", "end_x_m", "y_m", "approach_z_m", "target_z_m",
+    "start_delay_s", "approach_speed_m_per_s", "dwell_s", "scan_speed_m_per_s",
+    "end_dwell_s", "liftoff_height_m", "liftoff_s",
+)  # fmt: skip
+#: The fields of a DisturbanceConfig that the lift reads.
+_DISTURBANCE_FIELDS = ("table", "lifts")
 
 
-def target_knots(config: TrajectoryConfig) -> tuple[np.ndarray, np.ndarray]:
+def _check_config(config, fields, owner: str, kind: str) -> None:
+    """Raises VicDrakeError unless config has every field of a ``kind``."""
+    if not all(hasattr(config, name) for name in fields):
+        raise VicDrakeError(f"{owner} needs a {kind}; got {config!r}")
+
+
+def target_knots(config) -> tuple[np.ndarray, np.ndarray]:
     """Knots of the piecewise-linear target.
 
     Args:
@@ -70,7 +88,7 @@ def _smoothstep(u: np.ndarray) -> np.ndarray:
     return u * u * (3.0 - 2.0 * u)
 
 
-def phantom_lift_m(t_s, config: DisturbanceConfig) -> np.ndarray:
+def phantom_lift_m(t_s, config) -> np.ndarray:
     """Phantom z offset at times t_s, m (vectorised).
 
     Lifts rise and fall along smoothstep ramps (zero slope at both ends) and
@@ -93,18 +111,15 @@ class TargetTrajectorySource(LeafSystem):
     """The scan target x_d(t) from a :class:`TrajectoryConfig`.
 
     Output ports:
-        target_position: (3,) p_WT, m.
-        target_velocity: (3,) v_WT, m/s (piecewise constant).
+        target_position: (3,) x_d in W, m.
+        target_velocity: (3,) its rate in W, m/s (piecewise constant).
     """
 
-    def __init__(self, config: TrajectoryConfig):
+    def __init__(self, config):
         super().__init__()
-        from pydrake.trajectories import PiecewisePolynomial
-
-        if not isinstance(config, TrajectoryConfig):
-            raise VicDrakeError(
-                f"TargetTrajectorySource needs a TrajectoryConfig; got {config!r}"
-            )
+        _check_config(
+            config, _TRAJECTORY_FIELDS, "TargetTrajectorySource", "TrajectoryConfig"
+        )
         t, p = target_knots(config)
         self._trajectory = PiecewisePolynomial.FirstOrderHold(t, p)
         self._velocity = self._trajectory.derivative(1)
@@ -145,12 +160,11 @@ class PhantomLiftSource(LeafSystem):
         phantom_lift: (1,) z offset of the phantom, m.
     """
 
-    def __init__(self, config: DisturbanceConfig):
+    def __init__(self, config):
         super().__init__()
-        if not isinstance(config, DisturbanceConfig):
-            raise VicDrakeError(
-                f"PhantomLiftSource needs a DisturbanceConfig; got {config!r}"
-            )
+        _check_config(
+            config, _DISTURBANCE_FIELDS, "PhantomLiftSource", "DisturbanceConfig"
+        )
         self._config = config
         self._port = self.DeclareVectorOutputPort(
             "phantom_lift", BasicVector(1), self._calc

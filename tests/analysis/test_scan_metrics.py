@@ -1,0 +1,53 @@
+"""Scan metrics on records with known answers."""
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from tests.analysis.scans import make_scan
+from vic_drake.analysis.contact import scan_window
+from vic_drake.analysis.scan_metrics import (
+    force_range_N,
+    force_rmse_N,
+    peak_force_N,
+    penetration_stats,
+    tank_min_J,
+)
+from vic_drake.errors import VicDrakeError
+from vic_drake.tissue.phantom import SyntheticChestPhantom
+
+
+def test_force_rmse_and_range_against_hand_values():
+    t = np.arange(0, 10, 0.002)
+    f = np.where(t < 1, 0.0, 7.0 + np.sin(2 * np.pi * t))  # Contact from t = 1.
+    df = make_scan(t, f, force_ref_z_N=-7.0)
+    window = scan_window(df, settle_s=1.0)
+    assert t[window][0] == pytest.approx(2.0, abs=0.003)
+    # RMS of a unit sine over whole periods is 1/sqrt(2).
+    assert force_rmse_N(df) == pytest.approx(1 / np.sqrt(2), rel=2e-3)
+    lo, hi = force_range_N(df)
+    assert lo == pytest.approx(6.0, abs=1e-4) and hi == pytest.approx(8.0, abs=1e-4)
+    assert peak_force_N(df) == pytest.approx(8.0, abs=1e-4)
+
+
+def test_tank_min_and_missing_columns():
+    t = np.arange(0, 1, 0.01)
+    df = make_scan(t, np.ones_like(t), tank_energy_J=0.5 - 0.1 * t)
+    assert tank_min_J(df) == pytest.approx(0.401)
+    with pytest.raises(VicDrakeError, match="lacks columns"):
+        force_rmse_N(pd.DataFrame({"t_s": t}))
+
+
+def test_penetration_stats_split_ribs_from_soft_tissue():
+    phantom = SyntheticChestPhantom()
+    t = np.arange(0, 20, 0.01)
+    x = 0.036 - 0.01 * t
+    y = np.full_like(t, -0.36)
+    kappa = phantom.kappa(x, y)
+    pen = np.where(kappa > 7000, 0.003, 0.008)
+    df = make_scan(t, np.full_like(t, 7.0), x_m=x, y_m=y, penetration_m=pen)
+    stats = penetration_stats(df, phantom)
+    assert stats.rib_samples > 0 and stats.soft_samples > stats.rib_samples
+    assert stats.rib_mean_m == pytest.approx(
+        0.003
+    ) and stats.soft_mean_m == pytest.approx(0.008)

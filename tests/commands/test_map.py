@@ -1,0 +1,115 @@
+"""``vic-drake map``: the metrics contract, outputs and bad input."""
+
+import json
+
+import numpy as np
+import pytest
+
+from vic_drake.cli import main
+from vic_drake.commands.mapping import METRIC_KEYS
+
+SMALL = ["--region=-0.09,-0.06,-0.37,-0.35", "--resolution-mm", "1"]
+
+
+def test_map_json_contract_and_outputs(tmp_path, capsys):
+    out = tmp_path / "map"
+    status = main(
+        ["map", "--phantom", "synthetic", "--out", str(out), "--json", *SMALL]
+    )
+    captured = capsys.readouterr()
+    assert status == 0
+    result = json.loads(captured.out)  # stdout holds the JSON alone
+    assert tuple(result) == METRIC_KEYS
+    assert json.loads((out / "metrics.json").read_text()) == result
+    assert result["points"] == 12
+    for key in ("kappa_rmse_pct", "lambda_rmse_pct", "surface_rmse_mm", "wall_s"):
+        assert isinstance(result[key], float) and result[key] >= 0
+    assert result["kappa_rmse_pct"] < 10.0
+    assert result["surface_rmse_mm"] < 0.5
+    assert all(isinstance(v, float) for v in result["ribs_true"] + result["ribs_found"])
+    maps = np.load(out / "maps.npz")
+    for key in ("x", "y", "surface", "kappa", "lambda", "kappa_std", "lambda_std"):
+        assert key in maps
+    assert maps["kappa"].shape == (maps["x"].size, maps["y"].size) == (31, 21)
+    for name in (
+        "fig4_stiffness_damping.png",
+        "fig5_surface_kappa.png",
+        "gp_std.png",
+        "map_vs_truth.png",
+        "points.csv",
+    ):
+        assert (out / name).stat().st_size > 0
+    assert "[vic-drake]" in captured.err  # progress goes to stderr
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--phantom", "cardboard"], "--phantom must be one of"),
+        (["--resolution-mm", "-1"], "--resolution-mm"),
+        (["--resolution-mm", "nan"], "--resolution-mm"),
+        (["--spacing-cm", "0"], "--spacing-cm"),
+        (["--region", "1,2,3"], "--region"),
+        (["--region", "0.1,0.0,-0.4,-0.3"], "--region"),
+        (["--kernel", "cubic"], "--kernel"),
+        (["--resolution-mm", "0.001"], "map grid would have"),
+        (["--region=-0.09,-0.085,-0.37,-0.365"], "at least 4"),
+    ],
+)
+def test_bad_input_exits_2(tmp_path, capsys, args, message):
+    status = main(["map", "--out", str(tmp_path / "o"), *args])
+    assert status == 2
+    err = capsys.readouterr().err
+    assert "vic-drake: error:" in err and message in err
+
+
+def test_measured_without_data_exits_2(tmp_path, capsys):
+    status = main(
+        [
+            "map",
+            "--phantom",
+            "measured",
+            "--data-dir",
+            str(tmp_path / "none"),
+            "--out",
+            str(tmp_path / "o"),
+        ]
+    )
+    assert status == 2
+    assert "does not exist" in capsys.readouterr().err
+
+
+def test_out_that_is_a_file_exits_2(tmp_path, capsys):
+    path = tmp_path / "file"
+    path.write_text("x")
+    assert main(["map", "--out", str(path), *SMALL]) == 2
+    assert "is a file" in capsys.readouterr().err
+
+
+@pytest.mark.realdata
+def test_map_of_the_measured_phantom_small_region(data_dir, tmp_path, capsys):
+    out = tmp_path / "measured"
+    status = main(
+        [
+            "map",
+            "--phantom",
+            "measured",
+            "--data-dir",
+            str(data_dir),
+            "--out",
+            str(out),
+            "--json",
+            "--no-figures",
+            "--region=-0.12,-0.09,-0.38,-0.36",
+            "--resolution-mm",
+            "1",
+        ]
+    )
+    assert status == 0
+    result = json.loads(capsys.readouterr().out)
+    assert tuple(result) == METRIC_KEYS and result["points"] == 12
+    assert result["kappa_rmse_pct"] < 10.0
+    assert result["surface_rmse_mm"] < 0.5
+    # The rib near x = -10.6 cm of the measured map is found within 2 mm.
+    assert len(result["ribs_true"]) == len(result["ribs_found"]) == 1
+    assert result["ribs_found"][0] == pytest.approx(result["ribs_true"][0], abs=2e-3)

@@ -1,0 +1,66 @@
+"""The MathematicalProgram (OSQP, Clarabel) against the exact oracle."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+
+from tests.control.stiffness_qp.cases import problem, random_problems
+from vic_drake.control.stiffness_qp.exact import solve_stiffness_qp_exact
+from vic_drake.control.stiffness_qp.problem import (
+    stiffness_qp_cost,
+    stiffness_qp_violation,
+)
+from vic_drake.control.stiffness_qp.program import StiffnessQp
+
+
+def test_program_is_built_once(osqp):
+    prog = osqp.prog
+    cost, rows = prog.quadratic_costs()[0], prog.linear_constraints()[0]
+    for ez in (-0.01, -0.02, -0.03):
+        osqp.solve(problem((0.001, -0.002, ez), (0.01, 0.0, 0.02)))
+    assert osqp.prog is prog
+    assert len(prog.quadratic_costs()) == 1 and len(prog.linear_constraints()) == 1
+    assert prog.quadratic_costs()[0].evaluator() is cost.evaluator() or (
+        prog.quadratic_costs()[0].evaluator().get_description()
+        == cost.evaluator().get_description()
+    )
+    assert prog.linear_constraints()[0].evaluator().num_constraints() == 8
+    assert rows.evaluator().GetDenseA()[5, 2] != 0.0  # Updated in place: z force row.
+
+@settings(max_examples=300, deadline=None)
+@given(p=random_problems())
+def test_mathematical_program_matches_exact_oracle(osqp, p):
+    exact = solve_stiffness_qp_exact(p)
+    mp = osqp.solve(p)
+    assert mp.success == exact.success
+    if not exact.success:
+        return
+    viol = stiffness_qp_violation(p, mp.stiffness)
+    assert viol["bounds_N_per_m"] <= 1e-6 and viol["force_N"] <= 1e-6
+    assert viol["tank_energy_W"] <= 1e-6 and viol["tank_power_W"] <= 1e-6
+    assert np.allclose(mp.stiffness, exact.stiffness, atol=1e-6, rtol=0)
+    # Warm-started from a far point, OSQP lands on the same optimum.
+    warm = osqp.solve(p, guess=p.stiffness_max)
+    assert warm.success and np.allclose(
+        warm.stiffness, exact.stiffness, atol=1e-6, rtol=0
+    )
+    # The oracle is optimal: no feasible point of the solver is cheaper.
+    assert (
+        stiffness_qp_cost(p, exact.stiffness)
+        <= stiffness_qp_cost(p, mp.stiffness) * (1 + 1e-9) + 1e-9
+    )
+
+@settings(max_examples=60, deadline=None)
+@given(p=random_problems())
+def test_clarabel_matches_exact_oracle(clarabel, p):
+    exact = solve_stiffness_qp_exact(p)
+    mp = clarabel.solve(p)
+    assert mp.success == exact.success
+    if exact.success:
+        assert np.allclose(mp.stiffness, exact.stiffness, atol=0.5, rtol=0)
+
+def test_unknown_solver_is_a_clear_error():
+    from vic_drake.errors import VicDrakeError
+
+    with pytest.raises(VicDrakeError, match="'osqp', 'clarabel' or 'exact'"):
+        StiffnessQp("gurobi")

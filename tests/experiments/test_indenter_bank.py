@@ -1,0 +1,49 @@
+"""The indenter-bank diagram: n servo-driven indenters palpating tissue."""
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from vic_drake.experiments.indenter_bank import MakeIndenterDiagram
+from vic_drake.systems.indenter import IndenterParams, PalpationParams, SensorParams
+
+BETA = 1.35
+
+
+def test_indenter_diagram_static_equilibrium_matches_hunt_crossley():
+    """Constant target: the tip settles where servo and HC forces balance."""
+    from pydrake.systems.analysis import Simulator
+
+    indenter = IndenterParams()
+    palpation = PalpationParams(amplitude_m=0.0, duration_s=2.5)
+    sensor = SensorParams(noise_std_N=0.0)
+    n = 2
+    s = np.array([0.10, 0.12])
+    kappa, lam = np.array([2500.0, 9000.0]), np.array([2e4, 2e5])
+    bank = MakeIndenterDiagram(
+        n, beta=BETA, indenter=indenter, sensor=sensor, palpation=palpation
+    )
+    context = bank.diagram.CreateDefaultContext()
+    bank.set_points(
+        context, surface_z=s, kappa=kappa, lam=lam, start_z=s + 0.002, seed=1
+    )
+    Simulator(bank.diagram, context).AdvanceTo(4.0)
+    q = bank.plant.GetPositions(bank.plant.GetMyContextFromRoot(context))
+    contact = (
+        bank.target.get_contact_output_port()
+        .Eval(bank.target.GetMyContextFromRoot(context))
+        .reshape(3, n)
+    )
+    assert np.all(contact[0] == 1.0)
+    z_d = contact[1] - palpation.depth_m
+    measured = bank.sensor.get_measured_force_output_port().Eval(
+        bank.sensor.GetMyContextFromRoot(context)
+    )
+    k_p = indenter.servo_stiffness_N_per_m
+    for i in range(n):
+        # Independent oracle: kappa eps^beta = K_p (s - eps - z_d).
+        eps = brentq(
+            lambda e, i=i: kappa[i] * e**BETA - k_p * (s[i] - e - z_d[i]), 0.0, 0.05
+        )
+        assert s[i] - q[i] == pytest.approx(eps, abs=2e-6)
+        assert measured[i] == pytest.approx(kappa[i] * eps**BETA, rel=1e-3)

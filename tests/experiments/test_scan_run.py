@@ -1,0 +1,63 @@
+"""Simulating a scan: the canonical frame, figures from it, bad input, a full scan."""
+
+import numpy as np
+import pytest
+
+from vic_drake.analysis.columns import CANONICAL_COLUMNS
+from vic_drake.errors import VicDrakeError
+from vic_drake.experiments.paper_scenarios import synthetic_scenario
+from vic_drake.experiments.scan_diagram import MakeScanDiagram
+from vic_drake.experiments.scan_run import run_scan
+
+
+def test_short_run_returns_the_canonical_frame():
+    scenario = synthetic_scenario("vs-vf")
+    result = run_scan(scenario, duration_s=0.2)
+    df = result.df
+    assert tuple(df.columns) == CANONICAL_COLUMNS
+    assert df["t_s"].iloc[-1] == pytest.approx(0.2, abs=2.5e-3)
+    assert np.all(
+        np.isfinite(df[["x_m", "z_m", "force_sensor_z_N", "stiffness_z_N_per_m"]])
+    )
+    # The probe starts at rest where the IK put it: at the target, above the surface.
+    np.testing.assert_allclose(df[["x_m", "y_m"]].iloc[0], [0.036, -0.36], atol=1e-3)
+    assert df["z_m"].iloc[0] == pytest.approx(0.12, abs=1e-3)
+    assert df["penetration_m"].iloc[0] < 0  # Not touching yet.
+    assert result.rtf > 0 and result.wall_s > 0
+
+
+def test_scan_figures_draw_sim_and_real(tmp_path):
+    from vic_drake.reproduce.plots.scans import plot_comparison, plot_fig6, plot_fig7
+
+    df = run_scan(synthetic_scenario("vs-cf"), duration_s=0.1).df
+    fig = plot_fig6(
+        {"vs-cf": df, "vs-vf": df}, {"vs-vf": df}, save_path=tmp_path / "f6.png"
+    )
+    assert len(fig.axes) == 8 and (tmp_path / "f6.png").stat().st_size > 0
+    fig = plot_fig7({"vs-vf": df, "cs": df, "cf": df})
+    assert len(fig.axes) == 9
+    fig = plot_comparison(df, df)
+    assert len(fig.axes) == 3
+    with pytest.raises(VicDrakeError):
+        plot_fig6({})
+
+
+def test_run_scan_rejects_bad_input():
+    with pytest.raises(VicDrakeError, match="duration_s"):
+        run_scan(synthetic_scenario("cs"), duration_s=-1.0)
+    with pytest.raises(VicDrakeError, match="Scenario"):
+        MakeScanDiagram({"name": "not a scenario"})
+    with pytest.raises(VicDrakeError, match="controller"):
+        synthetic_scenario("pid")
+
+
+@pytest.mark.slow
+def test_full_vs_vf_nominal_scan_tracks_and_lifts_off():
+    """The whole synthetic VS-VF scan (~24 s simulated)."""
+    from vic_drake.analysis import scan_metrics as metrics
+
+    result = run_scan(synthetic_scenario("vs-vf"))
+    df = result.df
+    assert metrics.lifted_off(df)
+    assert metrics.tank_min_J(df) >= 0.4 - 1e-6
+    assert metrics.peak_force_N(df) < 15.0

@@ -1,0 +1,27 @@
+"""The ``scans`` stage: the scenarios of the paper's runs and their limits."""
+
+import pytest
+
+
+def test_scan_scenarios_cover_the_paper_runs():
+    from vic_drake.reproduce import CONTROLLERS, scan_limits, scan_scenario
+
+    for quick in (True, False):
+        for c in CONTROLLERS:
+            s = scan_scenario(c, disturbed=False, phantom_kind="synthetic", quick=quick)
+            assert s.controller.reference.controller == c
+            assert s.disturbance.is_nominal
+        d = scan_scenario("vs-vf", disturbed=True, phantom_kind="synthetic", quick=quick)
+        lifts = d.disturbance.lifts
+        assert len(lifts) == (2 if quick else 4)
+        # Every event ends (phantom back at rest) before the target lifts off.
+        traj = d.trajectory
+        scan_end = traj.end_time_s - traj.liftoff_s
+        for lift in lifts:
+            assert lift.start_s + lift.rise_s + lift.hold_s + lift.fall_s < scan_end
+        # Dropped below rest: contact loss must be possible.
+        assert min(lift.height_m for lift in lifts) < 0
+    lim = scan_limits(scan_scenario("vs-vf", disturbed=False, phantom_kind="synthetic",
+                                    quick=True))
+    assert lim.k_min_z_N_per_m == 100.0 and lim.tank_min_J == 0.4
+    assert lim.power_max_W == pytest.approx(0.1) and lim.eps_d_m == 0.008

@@ -1,0 +1,118 @@
+"""Force, tank and penetration metrics of one scan (canonical table).
+
+The windows, the contact rule and the contact losses these use are defined
+once in :mod:`vic_drake.analysis.contact`.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from vic_drake.analysis.columns import require_columns
+from vic_drake.analysis.contact import contact_mask, pressing_force_N, scan_window
+from vic_drake.paper import CONTACT_THRESHOLD_N
+
+#: kappa above which a point counts as "over a rib", N/m^beta. The measured
+#: map's soft tissue lies at 2,000-5,500 and its rib lines reach 9,000-10,236;
+#: 7,000 sits in the gap between the two populations of the histogram.
+RIB_KAPPA_THRESHOLD = 7000.0
+
+
+def force_rmse_N(df: pd.DataFrame, *, mask=None) -> float:
+    """RMS of (measured - reference) z force over the mask (default: scan window), N.
+
+    The reference is ``force_ref_z_N``; samples where it is NaN are skipped.
+    """
+    require_columns(df, "force_sensor_z_N", "force_ref_z_N")
+    mask = scan_window(df) if mask is None else np.asarray(mask, bool)
+    err = df["force_sensor_z_N"].to_numpy(float) - df["force_ref_z_N"].to_numpy(float)
+    err = err[mask & np.isfinite(err)]
+    return float(np.sqrt(np.mean(err**2))) if err.size else float("nan")
+
+
+def force_range_N(df: pd.DataFrame, *, mask=None) -> tuple[float, float]:
+    """(min, max) pressing force over the mask (default: scan window), N."""
+    mask = scan_window(df) if mask is None else np.asarray(mask, bool)
+    f = pressing_force_N(df)[mask]
+    return (float(f.min()), float(f.max())) if f.size else (float("nan"), float("nan"))
+
+
+def peak_force_N(df: pd.DataFrame) -> float:
+    """Largest pressing force of the whole run, N."""
+    return float(np.nanmax(pressing_force_N(df)))
+
+
+def tank_min_J(df: pd.DataFrame) -> float:
+    """Lowest tank energy of the run, J (NaN if the tank is not logged)."""
+    require_columns(df, "tank_energy_J")
+    e = df["tank_energy_J"].to_numpy(float)
+    return float(np.nanmin(e)) if np.isfinite(e).any() else float("nan")
+
+
+@dataclass(frozen=True)
+class PenetrationStats:
+    """Penetration (m) in contact over ribs and off ribs.
+
+    Attributes:
+        rib_mean_m, rib_max_m: over samples whose kappa exceeds the rib threshold.
+        soft_mean_m, soft_max_m: over the other samples in contact.
+        rib_samples, soft_samples: sample counts.
+    """
+
+    rib_mean_m: float
+    rib_max_m: float
+    soft_mean_m: float
+    soft_max_m: float
+    rib_samples: int
+    soft_samples: int
+
+
+def penetration_stats(
+    df: pd.DataFrame, phantom, *, rib_kappa_threshold: float = RIB_KAPPA_THRESHOLD
+) -> PenetrationStats:
+    """Penetration on ribs vs off ribs over the scan window (see RIB_KAPPA_THRESHOLD).
+
+    Args:
+        df: canonical scan; uses x_m, y_m, penetration_m (NaN rows skipped).
+        phantom: a :class:`vic_drake.tissue.phantom.Phantom` giving kappa(x, y).
+    """
+    require_columns(df, "x_m", "y_m", "penetration_m")
+    mask = scan_window(df)
+    kappa = np.asarray(
+        phantom.kappa(df["x_m"].to_numpy(float), df["y_m"].to_numpy(float))
+    )
+    pen = df["penetration_m"].to_numpy(float)
+    ok = mask & np.isfinite(pen)
+    rib = ok & (kappa > rib_kappa_threshold)
+    soft = ok & ~(kappa > rib_kappa_threshold)
+
+    def stats(sel):
+        if not sel.any():
+            return float("nan"), float("nan")
+        return float(np.mean(pen[sel])), float(np.max(pen[sel]))
+
+    rm, rx = stats(rib)
+    sm, sx = stats(soft)
+    return PenetrationStats(rm, rx, sm, sx, int(rib.sum()), int(soft.sum()))
+
+
+def liftoff_clearance_m(df: pd.DataFrame, *, tail_s: float = 0.5) -> float:
+    """Mean gap between tip and surface over the last tail_s of the run, m.
+
+    Positive = the probe left the surface. NaN where the surface is not known.
+    """
+    require_columns(df, "t_s", "penetration_m")
+    t = df["t_s"].to_numpy(float)
+    tail = t >= t[-1] - tail_s
+    pen = df["penetration_m"].to_numpy(float)[tail]
+    return float(-np.nanmean(pen)) if np.isfinite(pen).any() else float("nan")
+
+
+def lifted_off(
+    df: pd.DataFrame, *, tail_s: float = 0.5, threshold_N: float = CONTACT_THRESHOLD_N
+) -> bool:
+    """True when the probe is out of contact over the last tail_s of the run."""
+    t = df["t_s"].to_numpy(float)
+    tail = t >= t[-1] - tail_s
+    return bool(not contact_mask(df, threshold_N)[tail].any())

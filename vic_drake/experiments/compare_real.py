@@ -1,0 +1,148 @@
+"""A real scan replayed in simulation and compared with its log.
+
+:func:`compare_real` builds the scenario of a real bag
+(:func:`~vic_drake.experiments.real_logs.scenario_from_real_log`), replays
+the estimated phantom lift of a ``*_dist`` log, simulates it
+(:func:`~vic_drake.experiments.scan_run.run_scan`) and reduces both runs to
+the same metrics; ``vic-drake compare-real`` is a thin wrapper around it.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from vic_drake.analysis.columns import real_to_canonical
+from vic_drake.analysis.identification import (
+    estimate_force_loop_gain,
+    estimate_phantom_lift,
+    lift_table,
+)
+from vic_drake.analysis.real_comparison import compare_contact_loss, compare_with_real
+from vic_drake.errors import VicDrakeError
+from vic_drake.experiments.real_logs import (
+    REAL_SCAN_FORCE_DELAY_S,
+    nominal_sibling,
+    scenario_from_real_log,
+)
+from vic_drake.experiments.scan_run import run_scan
+from vic_drake.realdata import read_bag
+from vic_drake.scenario import DisturbanceConfig
+from vic_drake.tissue.phantom import load_phantom
+
+
+def compare_real(
+    bag_dir,
+    *,
+    controller: str | None = None,
+    stiffness_N_per_m: float | None = None,
+    force_N: float | None = None,
+    r_weight: float | None = None,
+    data_dir=None,
+    duration_s: float | None = None,
+    progress=None,
+    return_frames: bool = False,
+):
+    """Simulates a real experiment on the measured map and compares it with its log.
+
+    See :func:`scenario_from_real_log` for how the scenario is built. For a
+    ``*_dist`` log the phantom lift is estimated from the log
+    (:func:`vic_drake.analysis.identification.estimate_phantom_lift`, against the nominal
+    sibling log when it exists) and replayed; contact losses are compared.
+    Alignment: :func:`vic_drake.analysis.real_comparison.compare_with_real`.
+
+    Returns:
+        dict with the contract keys controller, duration_s, force_rmse_N,
+        force_peak_err_N, z_rmse_mm, kz_corr, tank_min_J, rtf, and more
+        (time offset, window, peaks, means, lift and contact-loss figures).
+        With ``return_frames``: (dict, sim DataFrame, real canonical DataFrame).
+    """
+    bag = Path(bag_dir)
+    if not bag.exists():
+        raise VicDrakeError(f"bag {str(bag)!r} does not exist; pass a ROS 2 bag folder")
+    if bag.is_file():
+        bag = bag.parent
+    raw = read_bag(bag)
+    if raw.attrs["layout"] not in ("controller", "scan"):
+        raise VicDrakeError(
+            f"bag {str(bag)!r} has the {raw.attrs['layout']!r} layout "
+            f"({raw.shape[1]} columns); compare-real needs a scan log: 31 columns "
+            "(VS controller) or 9 columns (CS/CF)"
+        )
+    real = real_to_canonical(raw)
+    phantom = load_phantom("measured", data_dir=data_dir, lookup="bilinear")
+    disturbance = None
+    lift_info = {}
+    is_dist = bag.name.endswith("_dist")
+    if is_dist:
+        sibling = nominal_sibling(bag)
+        nominal = real_to_canonical(read_bag(sibling)) if sibling else None
+        lift = estimate_phantom_lift(real, phantom, nominal=nominal)
+        disturbance = DisturbanceConfig(table=lift_table(lift))
+        lift_info = {
+            "lift_max_mm": float(1e3 * lift["phantom_lift_m"].max()),
+            "lift_reference": "nominal log" if sibling else "phantom map",
+        }
+    scenario = scenario_from_real_log(
+        raw,
+        name=bag.name,
+        controller=controller,
+        stiffness_N_per_m=stiffness_N_per_m,
+        force_N=force_N,
+        r_weight=r_weight,
+        disturbance=disturbance,
+    )
+    if progress:
+        progress(scenario.description)
+    result = run_scan(
+        scenario, phantom=phantom, duration_s=duration_s, progress=progress
+    )
+    lead = REAL_SCAN_FORCE_DELAY_S if raw.attrs["layout"] == "scan" else 0.0
+    metrics = compare_with_real(result.df, real, force_lead_s=lead)
+    unaligned = compare_with_real(result.df, real, force_lead_s=lead, align=False)
+    out = {
+        "controller": scenario.controller.reference.controller,
+        "duration_s": result.sim_s,
+        "force_rmse_N": metrics["force_rmse_N"],
+        "force_peak_err_N": metrics["force_peak_err_N"],
+        "z_rmse_mm": metrics["z_rmse_mm"],
+        "kz_corr": metrics["kz_corr"],
+        "tank_min_J": metrics["tank_min_J"]
+        if scenario.controller.reference.controller in ("vs-cf", "vs-vf")
+        else None,
+        "rtf": result.rtf,
+    }
+    out["rtf_cpu"] = result.sim_s / result.cpu_s if result.cpu_s > 0 else None
+    # The same figures without the time shift, so a shift at its bound or a
+    # weak correlation cannot flatter the comparison unseen.
+    out["force_rmse_unaligned_N"] = unaligned["force_rmse_N"]
+    out["z_rmse_unaligned_mm"] = unaligned["z_rmse_mm"]
+    out.update(
+        {k: v for k, v in metrics.items() if k not in out},
+        log=str(bag),
+        layout=raw.attrs["layout"],
+    )
+    # The FDCC z loop gain of the real log and of the simulation (see
+    # analysis.identification.estimate_force_loop_gain): how alike the two force loops are.
+    kind = scenario.controller.reference.controller
+    constant_k = (
+        scenario.controller.reference.constant_stiffness_N_per_m[2]
+        if kind == "cs"
+        else (0.0 if kind == "cf" else None)
+    )
+    fdcc_target = -scenario.controller.reference.force_ref_N if kind == "cf" else 0.0
+    for label, frame in (("real", real), ("sim", result.df)):
+        est = estimate_force_loop_gain(
+            frame, stiffness_z_N_per_m=constant_k, force_ref_z_N=fdcc_target
+        )
+        out[f"force_loop_gain_{label}"] = est["gain_m_per_s_per_N"]
+    out["fdcc_z_gains"] = [scenario.fdcc.p_gains[2], scenario.fdcc.d_gains[2]]
+    if is_dist:
+        out.update(lift_info)
+        seen = real[real["t_s"] <= result.df["t_s"].iloc[-1] + metrics["time_offset_s"]]
+        out.update(compare_contact_loss(result.df, seen))
+    if return_frames:
+        return out, result.df, real
+    return out
+
+
+__all__ = ["compare_real"]

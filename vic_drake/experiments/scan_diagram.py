@@ -1,0 +1,255 @@
+"""The closed-loop scan diagram of a scenario, and its initial state.
+
+:func:`MakeScanDiagram` wires the station (UR3e, F/T sensor, probe,
+phantom), the FDCC compliance stage, the variable impedance controller, the
+target and phantom-lift sources, and one ``LogVectorOutput`` per signal group
+of :data:`vic_drake.experiments.scan_logs.LOG_GROUPS`.
+
+Signal flow (all vectors in the base frame W)::
+
+    target ──► controller ◄── probe.position / probe.velocity / ft_sensor.force_W
+                 │ stiffness, target_force
+                 ▼
+    target ──► fdcc ◄── ur3e.state (q), ft_sensor.force_W
+                 │ position_command
+                 ▼
+    lift ────► station
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from pydrake.systems.framework import DiagramBuilder, LeafSystem
+from pydrake.systems.primitives import (
+    ConstantVectorSource,
+    Demultiplexer,
+    LogVectorOutput,
+)
+
+from vic_drake.errors import VicDrakeError
+from vic_drake.experiments.scan_logs import LOG_GROUPS
+from vic_drake.scenario import Scenario
+from vic_drake.station import (
+    MakeStation,
+    MakeUr3ePlant,
+    initial_q_for_tip,
+    set_station_state,
+)
+from vic_drake.systems.controller import MakeVariableImpedanceController
+from vic_drake.systems.fdcc import FdccController
+from vic_drake.systems.trajectory import PhantomLiftSource, TargetTrajectorySource
+from vic_drake.tissue.phantom import GridPhantom, load_phantom
+
+
+def load_scenario_phantom(scenario: Scenario, *, data_dir=None):
+    """The phantom of a scenario (the measured map needs the data folder)."""
+    return load_phantom(
+        scenario.phantom.kind, data_dir=data_dir, lookup=scenario.phantom.lookup
+    )
+
+
+def _controller_phantom(scenario: Scenario, phantom):
+    """The map the controller reads: the tissue's map with the controller's lookup.
+
+    A separate GridPhantom (sharing the arrays), not a copy: a phantom caches
+    its fast point lookup, and a copy would inherit the tissue's.
+    """
+    lookup = scenario.phantom.controller_lookup
+    if isinstance(phantom, GridPhantom) and phantom.lookup != lookup:
+        return GridPhantom(
+            x_m=phantom.x_m,
+            y_m=phantom.y_m,
+            z_m=phantom.surface_m - phantom.surface_offset_m,
+            kappa=phantom.kappa_grid,
+            lam=phantom.lam_grid,
+            beta=phantom.beta,
+            surface_offset_m=phantom.surface_offset_m,
+            lookup=lookup,
+            name=f"{phantom.name} ({lookup})",
+        )
+    return phantom
+
+
+class CommandedTipKinematics(LeafSystem):
+    """Probe tip position and velocity of a joint command (forward kinematics).
+
+    FZI's compliance controller on a position interface closes its loop on
+    its own joint command, not on the measured joints; with
+    ``Scenario.controller_feedback = "command"`` the variable impedance
+    controller reads the tip through this system likewise.
+
+    Input ports:
+        q: (6,) joint command, rad.
+    Output ports:
+        position: (3,) p_WP of FK(q), m.
+        velocity: (3,) finite difference over the last period, m/s.
+
+    State: the tip position at the last tick (3,), updated every period_s.
+    """
+
+    def __init__(self, station_params, *, period_s: float, q0):
+        super().__init__()
+        self._plant, handles = MakeUr3ePlant(station_params)
+        self._frame = handles.probe_frame
+        self._scratch = self._plant.CreateDefaultContext()  # FK scratch, no state.
+        self._period_s = float(period_s)
+        self._q_port = self.DeclareVectorInputPort("q", 6)
+        self._last = self.DeclareDiscreteState(self._fk(q0))
+        self.DeclarePeriodicDiscreteUpdateEvent(self._period_s, 0.0, self._update)
+        self.DeclareVectorOutputPort("position", 3, self._calc_position)
+        self.DeclareVectorOutputPort("velocity", 3, self._calc_velocity)
+
+    def _fk(self, q) -> np.ndarray:
+        self._plant.SetPositions(self._scratch, np.asarray(q, float))
+        return self._frame.CalcPoseInWorld(self._scratch).translation().copy()
+
+    def _update(self, context, discrete_state):
+        discrete_state.set_value(self._last, self._fk(self._q_port.Eval(context)))
+
+    def _calc_position(self, context, output):
+        output.SetFromVector(self._fk(self._q_port.Eval(context)))
+
+    def _calc_velocity(self, context, output):
+        p = self._fk(self._q_port.Eval(context))
+        last = context.get_discrete_state(self._last).get_value()
+        output.SetFromVector((p - last) / self._period_s)
+
+
+def MakeScanDiagram(scenario: Scenario, *, phantom=None, meshcat=None, data_dir=None):
+    """Builds the closed-loop scan diagram of a scenario.
+
+    Args:
+        scenario: the run's configuration.
+        phantom: the tissue (default: the scenario's phantom kind, loaded).
+        meshcat: optional Meshcat for visualisation.
+        data_dir: data folder for the measured map (default: vic_drake.paths).
+
+    Returns:
+        (diagram, loggers): the Diagram named "scan" and a dict
+        {group name: VectorLogSink} of :data:`LOG_GROUPS`.
+    """
+    if not isinstance(scenario, Scenario):
+        raise VicDrakeError(
+            f"MakeScanDiagram needs a Scenario; got {type(scenario).__name__}"
+        )
+    if phantom is None:
+        phantom = load_scenario_phantom(scenario, data_dir=data_dir)
+    q0 = initial_joint_positions(scenario)
+    builder = DiagramBuilder()
+    station = builder.AddNamedSystem(
+        "station",
+        MakeStation(scenario.station, phantom=phantom, meshcat=meshcat, initial_q=q0),
+    )
+    controller = builder.AddNamedSystem(
+        "variable_impedance_controller",
+        MakeVariableImpedanceController(
+            scenario.controller, phantom=_controller_phantom(scenario, phantom)
+        ),
+    )
+    fdcc = builder.AddNamedSystem(
+        "fdcc",
+        FdccController(scenario.fdcc, station_params=scenario.station, initial_q=q0),
+    )
+    target = builder.AddNamedSystem(
+        "target", TargetTrajectorySource(scenario.trajectory)
+    )
+    # A nominal run's phantom stays put: a constant (C++) source, evaluated
+    # for free every tick.
+    lift = builder.AddNamedSystem(
+        "phantom_lift",
+        ConstantVectorSource([0.0])
+        if scenario.disturbance.is_nominal
+        else PhantomLiftSource(scenario.disturbance),
+    )
+    demux = builder.AddNamedSystem("ur3e_state_demux", Demultiplexer([6, 6]))
+
+    force = station.GetOutputPort("ft_sensor.force_W")
+    if scenario.controller_feedback == "command":
+        tip = builder.AddNamedSystem(
+            "commanded_tip",
+            CommandedTipKinematics(
+                scenario.station, period_s=scenario.controller.period_s, q0=q0
+            ),
+        )
+        builder.Connect(fdcc.GetOutputPort("position_command"), tip.GetInputPort("q"))
+        tip_position = tip.GetOutputPort("position")
+        tip_velocity = tip.GetOutputPort("velocity")
+    else:
+        tip_position = station.GetOutputPort("probe.position")
+        tip_velocity = station.GetOutputPort("probe.velocity")
+    builder.Connect(tip_position, controller.GetInputPort("probe.position"))
+    builder.Connect(tip_velocity, controller.GetInputPort("probe.velocity"))
+    builder.Connect(force, controller.GetInputPort("ft_sensor.force_W"))
+    builder.Connect(
+        target.get_target_position_output_port(),
+        controller.GetInputPort("target_position"),
+    )
+    builder.Connect(station.GetOutputPort("ur3e.state"), demux.get_input_port())
+    builder.Connect(demux.get_output_port(0), fdcc.GetInputPort("joint_positions"))
+    builder.Connect(
+        target.get_target_position_output_port(), fdcc.GetInputPort("target_position")
+    )
+    builder.Connect(
+        controller.GetOutputPort("stiffness"), fdcc.GetInputPort("stiffness")
+    )
+    builder.Connect(force, fdcc.GetInputPort("measured_force"))
+    builder.Connect(
+        controller.GetOutputPort("target_force"), fdcc.GetInputPort("target_force")
+    )
+    builder.Connect(
+        fdcc.GetOutputPort("position_command"),
+        station.GetInputPort("ur3e.position_command"),
+    )
+    builder.Connect(lift.get_output_port(), station.GetInputPort("phantom.lift"))
+
+    sources = {
+        system.get_name(): system for system in (station, controller, fdcc, target)
+    }
+    loggers = {}
+    for group in LOG_GROUPS:
+        port = sources[group.source].GetOutputPort(group.port)
+        if port.size() != len(group.fields):
+            raise VicDrakeError(
+                f"log group {group.name!r}: port {group.source}.{group.port} has "
+                f"{port.size()} elements, the group names {len(group.fields)}"
+            )
+        logger = LogVectorOutput(port, builder, scenario.logging.period_s)
+        logger.set_name(f"log_{group.name}")
+        loggers[group.name] = logger
+    diagram = builder.Build()
+    diagram.set_name("scan")
+    return diagram, loggers
+
+
+def initial_joint_positions(scenario: Scenario) -> np.ndarray:
+    """UR3e joints placing the probe tip at the start of the scan, tool down (IK).
+
+    The tip starts at the target's start (x, y) and at
+    ``trajectory.start_tip_z_m``.
+    """
+    x, y, _ = scenario.trajectory.start_xyz_m
+    p_WP = np.array([x, y, scenario.trajectory.start_tip_z_m])
+    return np.asarray(initial_q_for_tip(p_WP, scenario.station), float)
+
+
+def set_initial_state(diagram, root_context, q0) -> None:
+    """Starts the arm at rest at q0 and every joint-command state at q0.
+
+    Sets the station's state (``station.set_station_state``: plant at q0,
+    phantom at zero lift, the joint servo's state) and the FDCC's command
+    state, so the first commanded motion is zero, not a jump from zero angles.
+    """
+    station = diagram.GetSubsystemByName("station")
+    station_context = station.GetMyMutableContextFromRoot(root_context)
+    set_station_state(station, station_context, q0)
+    fdcc = diagram.GetSubsystemByName("fdcc")
+    fdcc.set_initial_command(fdcc.GetMyMutableContextFromRoot(root_context), q0)
+
+
+__all__ = [
+    "CommandedTipKinematics",
+    "MakeScanDiagram",
+    "initial_joint_positions",
+    "load_scenario_phantom",
+    "set_initial_state",
+]

@@ -1,0 +1,62 @@
+"""The options of a reproduction run, checked when they are made."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from vic_drake.errors import VicDrakeError
+from vic_drake.paths import has_data, resolve_data_dir
+
+
+@dataclass
+class ReproduceOptions:
+    """Options of a reproduction run.
+
+    Attributes:
+        out_dir: folder for every output (created).
+        data_dir: the paper's measurements (None: the default lookup).
+        quick: shorter scans and a coarser map (see docs/decisions.md,
+            "Quick mode").
+        phantom: "auto" (measured map when the data is there, else synthetic),
+            "measured" or "synthetic".
+        stages: names of the stages to run (None: all).
+        progress: called with one line of progress text.
+    """
+
+    out_dir: Path
+    data_dir: Path | None = None
+    quick: bool = False
+    phantom: str = "auto"
+    stages: tuple[str, ...] | None = None
+    progress: Callable[[str], None] = lambda message: None
+
+    def __post_init__(self):
+        self.out_dir = Path(self.out_dir)
+        if self.phantom not in ("auto", "measured", "synthetic"):
+            raise VicDrakeError(
+                f"phantom must be 'auto', 'measured' or 'synthetic', got {self.phantom!r}"
+            )
+        if self.data_dir is not None and not has_data(self.data_dir):
+            raise VicDrakeError(
+                f"--data-dir {str(self.data_dir)!r} does not hold the paper's data; expected "
+                "phantom_map/, experiments/, palpation/ and loadcycle/ in it (omit the "
+                "option to run on the synthetic phantom)"
+            )
+        if self.phantom == "measured" and not has_data(self.data_dir):
+            raise VicDrakeError(
+                f"--phantom measured needs the paper's phantom map; none found at "
+                f"{str(resolve_data_dir(self.data_dir))!r} (pass --data-dir DIR or set "
+                "VIC_DRAKE_DATA)"
+            )
+        if self.stages is not None:
+            # Function-local: import cycle (the pipeline's stages take a
+            # RunContext, which holds these options).
+            from vic_drake.reproduce.pipeline import STAGE_NAMES
+
+            unknown = [s for s in self.stages if s not in STAGE_NAMES]
+            if unknown:
+                raise VicDrakeError(
+                    f"unknown stage(s) {unknown}; allowed: {', '.join(STAGE_NAMES)}"
+                )

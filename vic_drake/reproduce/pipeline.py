@@ -1,0 +1,119 @@
+"""The pipeline: the stages in order, each timed and recorded; the run's result.
+
+:func:`run_pipeline` runs the selected stages of :data:`STAGES` in order,
+times each, shows progress, and records a stage that fails (its error
+message, the traceback in ``logs/errors.txt``) instead of stopping: the
+claims that need a failed stage are then reported as not evaluated, with the
+reason, and fail. :func:`reproduce` is the library entry point.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+import traceback
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from vic_drake.errors import VicDrakeError
+from vic_drake.reproduce.context import RunContext, StageRecord, StageSkipped
+from vic_drake.reproduce.options import ReproduceOptions
+from vic_drake.reproduce.stages.claims import stage_claims
+from vic_drake.reproduce.stages.compare_real import stage_compare_real
+from vic_drake.reproduce.stages.map import stage_map
+from vic_drake.reproduce.stages.offline_real import stage_offline_real
+from vic_drake.reproduce.stages.offline_sim import stage_offline_sim
+from vic_drake.reproduce.stages.real_scans import stage_real_scans
+from vic_drake.reproduce.stages.replay import stage_replay
+from vic_drake.reproduce.stages.report import stage_report
+from vic_drake.reproduce.stages.scans import stage_scans
+
+STAGES: tuple[tuple[str, Callable[[RunContext], Any]], ...] = (
+    ("offline_real", stage_offline_real),
+    ("offline_sim", stage_offline_sim),
+    ("map", stage_map),
+    ("real_scans", stage_real_scans),
+    ("scans", stage_scans),
+    ("replay", stage_replay),
+    ("compare_real", stage_compare_real),
+    ("claims", stage_claims),
+    ("report", stage_report),
+)
+STAGE_NAMES = tuple(name for name, _ in STAGES)
+
+
+@dataclass
+class ReproduceResult:
+    """What a run produced."""
+
+    out_dir: Path
+    claims: dict
+    records: list[StageRecord]
+    wall_s: float
+    report_path: Path | None
+    results: dict
+
+    def summary(self) -> dict:
+        return {
+            "out_dir": str(self.out_dir),
+            "report": str(self.report_path) if self.report_path else None,
+            "wall_s": round(self.wall_s, 1),
+            "stages": [r.as_dict() for r in self.records],
+            "claims": {k: bool(v["pass"]) for k, v in self.claims.items()},
+        }
+
+
+def run_pipeline(ctx: RunContext) -> None:
+    """Runs the selected stages in order, timing and recording each."""
+    selected = ctx.options.stages
+    names = [n for n, _ in STAGES if selected is None or n in selected]
+    # claims and report always run last when anything ran.
+    for i, (name, fn) in enumerate((n, f) for n, f in STAGES if n in names):
+        ctx.progress(f"[{i + 1}/{len(names)}] {name} ...")
+        t0 = time.perf_counter()
+        try:
+            ctx.results[name] = fn(ctx)
+            rec = StageRecord(name, True, time.perf_counter() - t0)
+            ctx.progress(f"[{i + 1}/{len(names)}] {name} done in {rec.wall_s:.1f} s")
+        except StageSkipped as exc:
+            rec = StageRecord(name, False, time.perf_counter() - t0, f"skipped: {exc}",
+                              skipped=True)
+            ctx.progress(f"[{i + 1}/{len(names)}] {name} skipped: {exc}")
+        except Exception as exc:  # noqa: BLE001 - a failed stage is reported, not fatal
+            msg = f"{type(exc).__name__}: {exc}"
+            rec = StageRecord(name, False, time.perf_counter() - t0, msg)
+            ctx.progress(f"[{i + 1}/{len(names)}] {name} FAILED: {msg}")
+            log = ctx.out_dir / "logs" / "errors.txt"
+            log.parent.mkdir(parents=True, exist_ok=True)
+            with log.open("a", encoding="utf-8") as fh:
+                fh.write(f"--- stage {name}\n{traceback.format_exc()}\n")
+        ctx.records.append(rec)
+
+
+def reproduce(options: ReproduceOptions) -> ReproduceResult:
+    """Runs the reproduction; returns the claims and where everything is.
+
+    Raises:
+        VicDrakeError: the output folder cannot be created.
+    """
+    try:
+        options.out_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise VicDrakeError(f"cannot create the output folder {str(options.out_dir)!r}: "
+                            f"{exc.strerror}") from None
+    err_log = options.out_dir / "logs" / "errors.txt"
+    if err_log.exists():
+        err_log.unlink()
+    ctx = RunContext(options)
+    t0 = time.perf_counter()
+    run_pipeline(ctx)
+    wall = time.perf_counter() - t0
+    (options.out_dir / "run.json").write_text(
+        json.dumps({"wall_s": round(wall, 2), "quick": options.quick,
+                    "stages": [r.as_dict() for r in ctx.records]}, indent=2) + "\n",
+        encoding="utf-8")
+    claims = (ctx.results.get("claims") or {}).get("claims", {})
+    report = (ctx.results.get("report") or {}).get("path")
+    return ReproduceResult(options.out_dir, claims, ctx.records, wall, report, ctx.results)

@@ -1,0 +1,116 @@
+"""Stage ``map``: palpation campaign, GP maps of kappa and lambda, ribs (Fig. 4-5).
+
+The campaign palpates the scan phantom in simulation; its GP kappa map gives
+C3 "sim". The paper's own GP map (``phantom_map/``) gives C3 "real".
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from vic_drake.analysis.ribs import rib_prominences
+from vic_drake.realdata import read_phantom_map
+from vic_drake.reproduce.context import RunContext, _write_log
+from vic_drake.tissue import load_phantom
+
+#: The region the paper palpated (the measured map's extent), m.
+MAP_REGION_M = (-0.1587, 0.0423, -0.4145, -0.3125)
+
+
+def stage_map(ctx: RunContext) -> dict:
+    """Palpation campaign on a 1 cm grid, GP map of kappa and lambda, ribs.
+
+    The campaign palpates the scan phantom (the measured map when the data is
+    there, else the synthetic chest) in simulation; its GP kappa map gives C3
+    "sim". The paper's own GP map (``phantom_map/``) gives C3 "real".
+    """
+    # Function-local: the campaign pulls in pydrake, the GP maps scikit-learn
+    # and the plots matplotlib (heavy).
+    from vic_drake.experiments import CampaignParams, run_map_pipeline
+    from vic_drake.reproduce.plots.maps import (
+        plot_stiffness_damping_maps,
+        plot_surface_kappa,
+    )
+
+    out: dict = {}
+    real_map = None
+    if ctx.data_dir is not None:
+        real_map = read_phantom_map(ctx.data_dir / "phantom_map")
+    phantom = load_phantom(ctx.phantom_kind, data_dir=ctx.data_dir)
+    region = MAP_REGION_M
+    if ctx.options.quick:  # A 5 cm band across the ribs (the ribs run along y).
+        region = (region[0], region[1], -0.385, -0.335)
+    params = CampaignParams(spacing_m=0.01, region_m=region)
+    res = 0.001 if ctx.options.quick else 1e-4
+    # The same pipeline as `vic-drake map`; the comparison with the phantom
+    # is the stage's own (below, on a 1 mm subgrid).
+    mapped = run_map_pipeline(phantom, params, resolution_m=res, compare=False,
+                              progress=lambda m: ctx.progress(f"  {m}"))
+    campaign, tmap = mapped.campaign, mapped.tissue_map
+    _write_log(ctx, "campaign_points", campaign.points.drop(columns=["message"]),
+               {"campaign_params": params, "phantom": ctx.phantom_kind,
+                "lag_s": campaign.lag_s})
+    pts = campaign.ok
+    out["ribs_sim"] = rib_prominences(tmap.x_m, tmap.y_m, tmap.kappa)
+    out["campaign"] = campaign
+    out["tissue_map"] = tmap
+    # Error of the estimated kappa against the phantom, on a 1 mm subgrid.
+    step = max(1, int(round(1e-3 / res)))
+    xs, ys = tmap.x_m[::step], tmap.y_m[::step]
+    truth = phantom.sample(*np.meshgrid(xs, ys, indexing="ij"))
+    kerr = tmap.kappa[::step, ::step] - truth.kappa
+    out["kappa_rel_rmse"] = float(np.sqrt(np.mean(kerr**2)) / np.mean(truth.kappa))
+    ctx.add_figure(
+        "Fig. 4: GP maps of kappa and lambda",
+        f"GP maps every {res * 1e3:g} mm from {len(pts)} palpations simulated on a 1 cm grid "
+        f"of the {ctx.phantom_kind} phantom over x {region[0]:.3f}..{region[1]:.3f} m, "
+        f"y {region[2]:.3f}..{region[3]:.3f} m (dots: palpation points).",
+        plot_stiffness_damping_maps(tmap), "fig4_gp_maps.png")
+    ctx.add_figure(
+        "Fig. 4 (comparison): estimated maps and the paper's measured map",
+        "Top: the estimated maps with the detected ribs (red dotted lines); bottom (with "
+        "the paper's data): the paper's own GP map. kappa relative RMS error of the "
+        f"estimate against the phantom: {out['kappa_rel_rmse']:.1%}.",
+        _plot_maps(tmap, pts, real_map, out["ribs_sim"],
+                   rib_prominences(real_map.x_m, real_map.y_m, real_map.kappa)
+                   if real_map is not None else None),
+        "fig4_maps_vs_paper.png")
+    ctx.add_figure(
+        "Fig. 5: surface with elasticity",
+        "The GRIDFIT-like surface through the contact points, coloured by the kappa map "
+        "(the paper's Fig. 5).", plot_surface_kappa(tmap), "fig5_surface_kappa.png")
+    return out
+
+
+def _plot_maps(tmap, pts, real_map, ribs_sim, ribs_real):
+    # Function-local: matplotlib is heavy.
+    from matplotlib.figure import Figure
+
+    rows = 2 if real_map is not None else 1
+    fig = Figure(figsize=(11, 3.6 * rows))
+    axes = fig.subplots(rows, 2, squeeze=False)
+    step = max(1, int(np.ceil(tmap.x_m.size / 400)))
+
+    def show(ax, x, y, grid, title, ribs=None):
+        ext = [x[0], x[-1], y[0], y[-1]]
+        im = ax.imshow(grid.T, origin="lower", extent=ext, aspect="equal", cmap="viridis")
+        fig.colorbar(im, ax=ax, shrink=0.8)
+        ax.set_title(title, fontsize=9)
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("y [m]")
+        for xr in (ribs or {}).get("rib_position_m", []):
+            ax.axvline(xr, color="r", ls=":", lw=1)
+
+    xs, ys = tmap.x_m[::step], tmap.y_m[::step]
+    show(axes[0, 0], xs, ys, tmap.kappa[::step, ::step], "kappa, estimated [N/m^beta]",
+         ribs_sim)
+    axes[0, 0].plot(pts["x_m"], pts["y_m"], "k.", ms=2)
+    show(axes[0, 1], xs, ys, tmap.lam[::step, ::step],
+         "lambda, estimated [N s/m^(beta+1)]")
+    if real_map is not None:
+        show(axes[1, 0], real_map.x_m, real_map.y_m, real_map.kappa,
+             "kappa, the paper's measured map", ribs_real)
+        show(axes[1, 1], real_map.x_m, real_map.y_m, real_map.lam,
+             "lambda, the paper's measured map")
+    fig.tight_layout()
+    return fig

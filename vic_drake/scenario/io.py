@@ -1,0 +1,149 @@
+"""Scenario YAML: load with Drake's ``yaml_load_typed``, dump with ``yaml_dump_typed``.
+
+The loader fills a default :class:`~vic_drake.scenario.scenario.Scenario`
+field by field from the real annotations of the config dataclasses; fields
+missing from the file keep their defaults. ``__post_init__`` only ever saw
+those defaults, so :meth:`Scenario.validate` runs on what was loaded. Errors
+never surface as tracebacks: each is a :class:`VicDrakeError` naming the file
+(or "scenario YAML"), the field path and the bad value.
+"""
+
+import dataclasses
+import os
+import types
+import typing
+from pathlib import Path
+
+from pydrake.common.yaml import yaml_dump_typed, yaml_load, yaml_load_typed
+
+from vic_drake.errors import VicDrakeError
+from vic_drake.scenario.scenario import Scenario
+
+
+def load_scenario(path: str | os.PathLike) -> Scenario:
+    """Loads a scenario YAML with ``yaml_load_typed`` and validates it.
+
+    Fields missing from the file keep their defaults; unknown fields, wrong
+    types and invalid values raise.
+
+    Raises:
+        VicDrakeError: naming the file and the offending field and value.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise VicDrakeError(f"scenario file {str(path)!r} does not exist")
+    return _load({"filename": str(path)}, f"scenario file {str(path)!r}")
+
+
+def loads_scenario(text: str) -> Scenario:
+    """Like :func:`load_scenario`, from YAML text."""
+    return _load({"data": text}, "scenario YAML")
+
+
+def _load(source: dict, where: str) -> Scenario:
+    """yaml_load_typed on one source (``filename=`` or ``data=``), then validate."""
+    try:
+        scenario = yaml_load_typed(schema=Scenario, **source)
+    except VicDrakeError as exc:
+        raise VicDrakeError(f"{where}: {exc}") from None
+    except Exception as exc:
+        # Drake's loader raises RuntimeError, ValueError or yaml errors.
+        raise VicDrakeError(
+            f"{where}: {_locate_error(source, exc)} "
+            "(the fields and types are those of vic_drake.scenario.Scenario)"
+        ) from None
+    try:
+        return scenario.validate()
+    except (VicDrakeError, TypeError, ValueError) as exc:
+        raise VicDrakeError(f"{where}: {exc}") from None
+
+
+def _locate_error(source: dict, exc: Exception) -> str:
+    """Names the field path of an error the Drake loader reported without one."""
+    try:
+        raw = yaml_load(**source)
+    except Exception:
+        return str(exc)
+    path = _first_bad_field(raw, Scenario, "")
+    return f"field {path}" if path else f"{type(exc).__name__}: {exc}"
+
+
+def _record_types(tp) -> dict | None:
+    """Field name -> annotation of a dataclass or a Drake-bound config type."""
+    if dataclasses.is_dataclass(tp) and isinstance(tp, type):
+        return {f.name: f.type for f in dataclasses.fields(tp)}
+    fields = getattr(tp, "__fields__", None)  # DefAttributesUsingSerialize.
+    if isinstance(tp, type) and fields is not None:
+        return {f.name: f.type for f in fields}
+    return None
+
+
+_SCALARS = {float: (int, float), int: (int,), str: (str,), bool: (bool,)}
+
+
+def _first_bad_field(value, tp, path: str) -> str | None:
+    """Path and problem of the first value that does not fit annotation tp."""
+    hints = _record_types(tp)
+    if hints is not None:
+        if not isinstance(value, dict):
+            return f"{path or '<root>'} must be a mapping; got {value!r}"
+        for key, item in value.items():
+            sub = f"{path}.{key}".lstrip(".")
+            if key not in hints:
+                return f"{sub} is unknown; allowed: {sorted(hints)}"
+            bad = _first_bad_field(item, hints[key], sub)
+            if bad:
+                return bad
+        return None
+    origin, args = typing.get_origin(tp), typing.get_args(tp)
+    if origin in (typing.Union, types.UnionType):
+        if value is None:
+            return None
+        return _first_bad_field(
+            value, [a for a in args if a is not type(None)][0], path
+        )
+    if origin is list:
+        if not isinstance(value, list):
+            return f"{path} must be a list; got {value!r}"
+        for i, item in enumerate(value):
+            bad = _first_bad_field(
+                item, args[0] if args else typing.Any, f"{path}[{i}]"
+            )
+            if bad:
+                return bad
+        return None
+    if tp in _SCALARS:
+        ok = isinstance(value, _SCALARS[tp]) and not (
+            tp is not bool and isinstance(value, bool)
+        )
+        if not ok:
+            return f"{path} must be a {tp.__name__}; got {value!r}"
+    return None
+
+
+def dumps_scenario(scenario: Scenario, *, only_changes: bool = False) -> str:
+    """The scenario as YAML text (``yaml_dump_typed``), loadable by load_scenario.
+
+    Args:
+        scenario: what to write.
+        only_changes: write only the fields that differ from ``Scenario()``
+            (Drake's ``defaults=``), as the files in ``diagrams/`` do: short,
+            and they follow improvements of the defaults. False (default)
+            writes every field: the exact record of a run.
+    """
+    if not isinstance(scenario, Scenario):
+        raise VicDrakeError(
+            f"dumps_scenario needs a Scenario; got {type(scenario).__name__}"
+        )
+    defaults = Scenario() if only_changes else None
+    return yaml_dump_typed(scenario, schema=Scenario, defaults=defaults)
+
+
+def save_scenario(
+    scenario: Scenario, path: str | os.PathLike, *, only_changes: bool = False
+) -> Path:
+    """Writes the scenario as YAML (see :func:`dumps_scenario`); returns the path."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(dumps_scenario(scenario, only_changes=only_changes))
+    return path

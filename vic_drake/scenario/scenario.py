@@ -1,0 +1,217 @@
+"""The Scenario: the whole configuration of one closed-loop scan.
+
+A :class:`Scenario` is a tree of mutable dataclasses (phantom, station,
+controller, FDCC, reference trajectory, phantom-lift disturbance, logging,
+simulator, seed, duration) that Drake's ``yaml_load_typed`` fills field by
+field (:mod:`vic_drake.scenario.io`). Every field carries its unit in its
+name or comment; every invariant is checked in ``__post_init__`` and again in
+:meth:`Scenario.validate`, which the loader calls on what it loaded, with
+messages that name the field and the bad value.
+
+The default scenario is the paper's VS-VF nominal scan on the synthetic
+phantom: the target comes down from above to z = 0.085 m at 1 cm/s, moves
+along -x at 1 cm/s for 20 cm, then jumps up (lift-off), as the real logs do.
+"""
+
+from dataclasses import dataclass, field
+
+from pydrake.systems.analysis import GetIntegrationSchemes, SimulatorConfig
+
+from vic_drake.control.fdcc import FdccParams
+from vic_drake.control.params import (
+    ControllerParams,
+    ReferenceParams,
+    StiffnessQpParams,
+)
+from vic_drake.errors import VicDrakeError
+from vic_drake.scenario.checks import check_number
+from vic_drake.scenario.disturbance import DisturbanceConfig
+from vic_drake.scenario.logging import LoggingConfig
+from vic_drake.scenario.phantom import PhantomConfig
+from vic_drake.scenario.plain import as_plain
+from vic_drake.scenario.trajectory import TrajectoryConfig
+from vic_drake.station.params import StationParams
+
+#: The stiffness QP solver of the scans: the closed-form solver (the same K
+#: as OSQP's, and cheaper per tick; see docs/decisions.md, "Scan QP solver",
+#: and :class:`vic_drake.control.params.StiffnessQpParams`). Set
+#: ``controller.qp.solver: osqp`` in a scenario to run Drake's
+#: MathematicalProgram instead.
+SCAN_QP_SOLVER = "exact"
+
+#: Where the controller reads the probe's position and velocity.
+CONTROLLER_FEEDBACKS = ("measured", "command")
+
+
+def _vs_vf_controller() -> ControllerParams:
+    """VS-VF as on the real rig (test_nardi_matForce_lowR: R = 1e-5)."""
+    return ControllerParams(
+        qp=StiffnessQpParams(r_weight=[1e-5, 1e-5, 1e-5], solver=SCAN_QP_SOLVER),
+        reference=ReferenceParams(controller="vs-vf"),
+    )
+
+
+def _validate_part(owner: str, name: str, value, kind: type) -> None:
+    """Checks that a nested config has its type, then runs its own checks."""
+    if not isinstance(value, kind):
+        raise VicDrakeError(f"{owner}.{name} must be a {kind.__name__}; got {value!r}")
+    validate = getattr(value, "validate", None)
+    if callable(validate):
+        validate()
+    else:
+        # A config without validate() checks itself in __post_init__ only;
+        # run that again on the values the loader wrote into it.
+        post_init = getattr(value, "__post_init__", None)
+        if callable(post_init):
+            post_init()
+
+
+def _validate_simulator(owner: str, config: SimulatorConfig) -> None:
+    schemes = GetIntegrationSchemes()
+    if config.integration_scheme not in schemes:
+        raise VicDrakeError(
+            f"{owner}.simulator.integration_scheme must be one of {schemes}; "
+            f"got {config.integration_scheme!r}"
+        )
+    check_number(
+        f"{owner}.simulator",
+        "max_step_size",
+        config.max_step_size,
+        low=0.0,
+        low_open=True,
+    )
+    check_number(
+        f"{owner}.simulator", "accuracy", config.accuracy, low=0.0, low_open=True
+    )
+    check_number(
+        f"{owner}.simulator",
+        "target_realtime_rate",
+        config.target_realtime_rate,
+        low=0.0,
+    )
+    if config.start_time != 0.0:
+        # The target, the disturbance and the logs are timed from t = 0.
+        raise VicDrakeError(
+            f"{owner}.simulator.start_time must be 0 (a scan starts at t = 0); "
+            f"got {config.start_time!r}"
+        )
+
+
+@dataclass
+class Scenario:
+    """One closed-loop scan: phantom, station, controller, FDCC, references.
+
+    Equality compares the plain forms (:func:`vic_drake.scenario.plain.as_plain`):
+    Drake's bound configs have no ``==`` and tuples equal lists of the same
+    items. Pickling sends the simulator config as its fields.
+
+    Attributes:
+        name: label of the run (used in reports and file names).
+        description: free text (which paper figure or real log it mirrors).
+        phantom: the tissue.
+        station: the UR3e + F/T sensor + probe + phantom plant
+            (default StationParams(): no sensor lag in the loop, see there).
+        controller: the variable impedance controller (tank, QP, reference).
+        fdcc: the forward-dynamics compliance controller that turns
+            stiffness and target force into joint position commands
+            (default FdccParams(): pose error on the measured joints).
+        trajectory: the target x_d(t).
+        disturbance: the phantom lift z_offset(t).
+        logging: recording period.
+        simulator: Drake's simulator settings (integrator, real-time rate),
+            applied with ``ApplySimulatorConfig``. The scan diagram is purely
+            discrete, so the integrator settings do not change its result.
+        controller_feedback: "measured" or "command" (see the field).
+        seed: seed of every random element of the diagram (sensor noise).
+        duration_s: simulated time, s; None means trajectory end + 1 s.
+    """
+
+    name: str = "vs_vf_nominal_synthetic"
+    description: str = ""
+    phantom: PhantomConfig = field(default_factory=PhantomConfig)
+    station: StationParams = field(default_factory=StationParams)
+    controller: ControllerParams = field(default_factory=_vs_vf_controller)
+    fdcc: FdccParams = field(default_factory=FdccParams)
+    trajectory: TrajectoryConfig = field(default_factory=TrajectoryConfig)
+    disturbance: DisturbanceConfig = field(default_factory=DisturbanceConfig)
+    logging: LoggingConfig = field(default_factory=LoggingConfig)
+    simulator: SimulatorConfig = field(default_factory=SimulatorConfig)
+    # Where the controller reads the probe's position and velocity: "measured"
+    # (the station's probe) or "command" (forward kinematics of the FDCC's
+    # joint command, what FZI's controller on a position interface sees).
+    controller_feedback: str = "measured"
+    seed: int = 0  # Seed of the random elements (sensor noise), >= 0.
+    duration_s: float | None = None  # Simulated time, s (None: trajectory end + 1 s).
+
+    def __post_init__(self):
+        self.validate()
+
+    def validate(self) -> "Scenario":
+        """Checks every field and every nested config; returns self.
+
+        Raises:
+            VicDrakeError: naming the field and the bad value.
+        """
+        o = "Scenario"
+        if not isinstance(self.name, str) or not self.name:
+            raise VicDrakeError(
+                f"{o}.name must be a non-empty string; got {self.name!r}"
+            )
+        parts = (
+            ("phantom", PhantomConfig),
+            ("station", StationParams),
+            ("controller", ControllerParams),
+            ("fdcc", FdccParams),
+            ("trajectory", TrajectoryConfig),
+            ("disturbance", DisturbanceConfig),
+            ("logging", LoggingConfig),
+        )
+        for name, kind in parts:
+            _validate_part(o, name, getattr(self, name), kind)
+        if not isinstance(self.simulator, SimulatorConfig):
+            raise VicDrakeError(
+                f"{o}.simulator must be a SimulatorConfig; got {self.simulator!r}"
+            )
+        _validate_simulator(o, self.simulator)
+        if self.controller_feedback not in CONTROLLER_FEEDBACKS:
+            raise VicDrakeError(
+                f"{o}.controller_feedback must be 'measured' or 'command'; "
+                f"got {self.controller_feedback!r}"
+            )
+        if (
+            isinstance(self.seed, bool)
+            or not isinstance(self.seed, int)
+            or self.seed < 0
+        ):
+            raise VicDrakeError(f"{o}.seed must be an integer >= 0; got {self.seed!r}")
+        if self.duration_s is not None:
+            check_number(o, "duration_s", self.duration_s, low=0.0, low_open=True)
+        return self
+
+    def __eq__(self, other):
+        if not isinstance(other, Scenario):
+            return NotImplemented
+        return as_plain(self) == as_plain(other)
+
+    __hash__ = None  # Mutable, as a dataclass with eq.
+
+    # SimulatorConfig cannot be pickled: pickle its fields (scenarios are
+    # sent to worker processes).
+    def __getstate__(self):
+        state = dict(self.__dict__)
+        if isinstance(self.simulator, SimulatorConfig):
+            state["simulator"] = as_plain(self.simulator)
+        return state
+
+    def __setstate__(self, state):
+        state = dict(state)
+        if isinstance(state.get("simulator"), dict):
+            state["simulator"] = SimulatorConfig(**state["simulator"])
+        self.__dict__.update(state)
+
+    @property
+    def total_duration_s(self) -> float:
+        """The simulated time of a full run, s."""
+        if self.duration_s is not None:
+            return float(self.duration_s)
+        return self.trajectory.end_time_s + 1.0

@@ -1,0 +1,412 @@
+"""MakeStation: the simulated rig as a Diagram (UR3e, F/T sensor, indenter, phantom).
+
+The arm and tool are :mod:`vic_drake.models.ur3e`; the phantom (body Ph) is
+the chest on a prismatic z joint (``phantom_lift``) at ``phantom_offset_m``;
+its frame carries the map's coordinates, so with zero lift and offset the
+map is in W.
+
+Forces: the tissue's push on the indenter is the Hunt-Crossley element of
+:mod:`vic_drake.systems.tissue_force` (Drake contact between the indenter
+and the phantom is filtered out). Robot links and the sensor housing have
+coarse rigid hydroelastic geometry that meets the phantom's compliant
+hydroelastic volume mesh (:mod:`vic_drake.models.phantom_mesh`): a safety
+contact, not the measured force.
+
+The arm is position controlled through the servo front end of
+:mod:`vic_drake.station.servo`, with the arm's gravity torques as
+feed-forward (the UR controller compensates gravity itself). Effort limits
+are the URDF's (56, 56, 28, 12, 12, 12 N m).
+
+Notes for users: the plant's output ports are sampled (Drake's default for
+discrete plants), so ``plant.contact_results`` and the reaction forces
+behind the F/T reading describe the last plant step -- take one step after
+setting a state by hand. The sensor noise comes from a ``RandomSource``
+whose seed lives in the Context (deterministic by default; call
+``diagram.SetRandomContext(context, RandomGenerator(seed))`` for another
+draw). Speed (``benchmarks/bench_station.py``, ``benchmarks/bench_scan.py``):
+the plant steps with the command, so each Python LeafSystem (tissue force
+and tip kinematics, sensor, servo filter; in a scan the controller and FDCC)
+runs once per step.
+"""
+
+import numpy as np
+from pydrake.common import RandomDistribution
+from pydrake.geometry import (
+    AddCompliantHydroelasticProperties,
+    AddContactMaterial,
+    AddRigidHydroelasticProperties,
+    CollisionFilterDeclaration,
+    GeometrySet,
+    Mesh,
+    ProximityProperties,
+    RoleAssign,
+)
+from pydrake.math import RigidTransform
+from pydrake.multibody.plant import (
+    AddMultibodyPlant,
+    CoulombFriction,
+    MultibodyPlant,
+)
+from pydrake.multibody.tree import (
+    FixedOffsetFrame,
+    PdControllerGains,
+    PrismaticJoint,
+    SpatialInertia,
+    UnitInertia,
+)
+from pydrake.systems.controllers import InverseDynamics
+from pydrake.systems.framework import Diagram, DiagramBuilder
+from pydrake.systems.primitives import (
+    Demultiplexer,
+    LinearSystem,
+    MatrixGain,
+    Multiplexer,
+    RandomSource,
+    StateInterpolatorWithDiscreteDerivative,
+)
+
+from vic_drake.errors import VicDrakeError
+from vic_drake.models.phantom_mesh import phantom_mesh_paths
+from vic_drake.models.ur3e import UR3E_JOINTS, AddTool, AddUr3e
+from vic_drake.station.params import StationParams
+from vic_drake.station.servo import (
+    _set_pd_gains,
+    joint_servo_rest_state,
+    joint_servo_system_matrices,
+)
+from vic_drake.systems.ft_sensor import ForceTorqueSensor
+from vic_drake.systems.tissue_force import TissueForceElement
+from vic_drake.tissue import Phantom
+
+
+def _add_phantom(plant, params: StationParams, phantom: Phantom):
+    model = plant.AddModelInstance("phantom")
+    x_min, x_max, y_min, y_max = phantom.bounds
+    size = np.array([x_max - x_min, y_max - y_min, params.phantom_thickness_m])
+    body = plant.AddRigidBody(
+        "phantom",
+        model,
+        SpatialInertia(
+            params.phantom_mass_kg,
+            np.zeros(3),
+            UnitInertia.SolidBox(*size),
+        ),
+    )
+    frame_on_world = plant.AddFrame(
+        FixedOffsetFrame(
+            "phantom_base", plant.world_frame(), RigidTransform(params.phantom_offset_m)
+        )
+    )
+    joint = plant.AddJoint(
+        PrismaticJoint("phantom_lift", frame_on_world, body.body_frame(), [0, 0, 1])
+    )
+    actuator = plant.AddJointActuator("phantom_lift_actuator", joint)
+    actuator.set_controller_gains(
+        PdControllerGains(p=params.phantom_kp_N_per_m, d=params.phantom_kd_Ns_per_m)
+    )
+    vtk, obj = phantom_mesh_paths(
+        phantom,
+        resolution_m=params.phantom_mesh_resolution_m,
+        thickness_m=params.phantom_thickness_m,
+    )
+    props = ProximityProperties()
+    AddCompliantHydroelasticProperties(
+        params.phantom_mesh_resolution_m, params.hydroelastic_modulus_Pa, props
+    )
+    AddContactMaterial(
+        params.hunt_crossley_dissipation_s_per_m,
+        None,
+        CoulombFriction(params.friction_coefficient, params.friction_coefficient),
+        props,
+    )
+    geometry = plant.RegisterCollisionGeometry(
+        body, RigidTransform(), Mesh(str(vtk)), "phantom_collision", props
+    )
+    plant.RegisterVisualGeometry(
+        body, RigidTransform(), Mesh(str(obj)), "phantom_visual", [0.9, 0.75, 0.65, 1.0]
+    )
+    return model, body, geometry
+
+
+def _make_links_hydroelastic(plant, scene_graph, ur3e, params):
+    """Gives the URDF's primitive link collisions coarse rigid hydroelastic properties."""
+    ids = []
+    for body_index in plant.GetBodyIndices(ur3e):
+        for gid in plant.GetCollisionGeometriesForBody(plant.get_body(body_index)):
+            props = ProximityProperties()
+            AddRigidHydroelasticProperties(params.hydroelastic_resolution_hint_m, props)
+            AddContactMaterial(
+                params.hunt_crossley_dissipation_s_per_m,
+                None,
+                CoulombFriction(
+                    params.friction_coefficient, params.friction_coefficient
+                ),
+                props,
+            )
+            scene_graph.AssignRole(
+                plant.get_source_id(), gid, props, RoleAssign.kReplace
+            )
+            ids.append(gid)
+    return ids
+
+
+def MakeStation(
+    params: StationParams,
+    *,
+    phantom: Phantom,
+    meshcat=None,
+    initial_q=None,
+) -> Diagram:
+    """Builds the simulated rig as a Diagram named ``"station"``.
+
+    Args:
+        params: the rig (:class:`StationParams`).
+        phantom: the tissue map (its surface gives the contact mesh, its
+            kappa, lambda, beta the Hunt-Crossley force).
+        meshcat: optional Meshcat for visualization.
+        initial_q: optional default joint angles (6,), rad (e.g. from
+            :func:`initial_q_for_tip`); default all zero.
+
+    Input ports:
+        ur3e.position_command (6): commanded joint angles, rad.
+        phantom.lift (1): phantom z offset command, m (servoed stiffly).
+    Output ports:
+        ur3e.state (12): q (rad), v (rad/s).
+        ft_sensor.force_W (3): tared, noisy (and, with sensor_lag_samples,
+            delayed) sensor force in W, N
+            (negative z = the probe pressing down into the body).
+        ft_sensor.wrench_S (6): the same reading ``[tau; f]`` in the sensor
+            frame S (N m, N).
+        probe.position (3): p_WP of the tip, m.  probe.velocity (3): m/s.
+        tissue.force_W (3): true Hunt-Crossley force on the tip, N (+z up).
+        tissue.penetration (1): eps = surface - tip height, m.
+        tissue.surface_z (1): surface height under the tip in W, m.
+        phantom.z_offset (1): the phantom's current lift, m.
+        plant.body_poses, plant.contact_results: for logging/visualization.
+    """
+    if not isinstance(params, StationParams):
+        raise VicDrakeError(
+            f"params must be a StationParams, got {type(params).__name__}"
+        )
+    if not isinstance(phantom, Phantom):
+        raise VicDrakeError(
+            f"phantom must be a vic_drake.tissue.Phantom, got {type(phantom).__name__}"
+        )
+    params.validate()
+    builder = DiagramBuilder()
+    plant, scene_graph = AddMultibodyPlant(params.plant, builder)
+    plant.mutable_gravity_field().set_gravity_vector([0, 0, -params.gravity_m_per_s2])
+    ur3e = AddUr3e(plant)
+    arm = AddTool(plant, ur3e, params)
+    phantom_model, phantom_body, phantom_geometry = _add_phantom(plant, params, phantom)
+    link_geometries = _make_links_hydroelastic(plant, scene_graph, ur3e, params)
+    tool_geometries = list(arm.tool_geometries.values())
+    indenter_geometries = [
+        arm.tool_geometries["indenter_cone"],
+        arm.tool_geometries["indenter_tip"],
+    ]
+    filters = CollisionFilterDeclaration()
+    # No self collision of the arm and tool (the URDF's primitives overlap).
+    filters.ExcludeWithin(GeometrySet(link_geometries + tool_geometries))
+    # The indenter's contact with tissue is the Hunt-Crossley element only.
+    filters.ExcludeBetween(
+        GeometrySet(indenter_geometries), GeometrySet([phantom_geometry])
+    )
+    if not params.robot_contact:
+        filters.ExcludeBetween(
+            GeometrySet(link_geometries + tool_geometries),
+            GeometrySet([phantom_geometry]),
+        )
+    scene_graph.collision_filter_manager().Apply(filters)
+    plant.Finalize()
+    _set_pd_gains(
+        plant,
+        UR3E_JOINTS,
+        ur3e,
+        params.joint_kp_Nm_per_rad,
+        params.joint_kd_Nms_per_rad,
+    )
+    if initial_q is not None:
+        q0 = np.asarray(initial_q, float)
+        if q0.shape != (6,) or not np.all(np.isfinite(q0)):
+            raise VicDrakeError(
+                f"initial_q must be 6 finite joint angles (rad), got {initial_q!r}"
+            )
+        plant.SetDefaultPositions(ur3e, q0)
+
+    # Position servo: the command, smoothed as the UR's servoj does, is the
+    # desired state of the PD actuators.
+    q_default = plant.GetDefaultPositions(ur3e)
+    ur_measured = builder.AddNamedSystem("ur3e_state_demux", Demultiplexer([6, 6]))
+    servo_inputs = builder.AddNamedSystem("ur3e_servo_inputs", Multiplexer([6, 6]))
+    ur_filter = builder.AddNamedSystem(
+        "ur3e_servo_filter",
+        LinearSystem(
+            *joint_servo_system_matrices(
+                6,
+                params.command_period_s,
+                params.servo_time_constant_s,
+                params.servo_integral_time_s,
+            ),
+            params.command_period_s,
+        ),
+    )
+    ur_filter.configure_default_state(joint_servo_rest_state(q_default))
+    builder.Connect(plant.get_state_output_port(ur3e), ur_measured.get_input_port())
+    builder.Connect(ur_measured.get_output_port(0), servo_inputs.get_input_port(1))
+    builder.Connect(servo_inputs.get_output_port(), ur_filter.get_input_port())
+    builder.Connect(
+        ur_filter.get_output_port(), plant.get_desired_state_input_port(ur3e)
+    )
+    builder.ExportInput(servo_inputs.get_input_port(0), "ur3e.position_command")
+    lift_interp = builder.AddNamedSystem(
+        "phantom_lift_interpolator",
+        StateInterpolatorWithDiscreteDerivative(1, params.command_period_s, True),
+    )
+    builder.Connect(
+        lift_interp.get_output_port(), plant.get_desired_state_input_port(phantom_model)
+    )
+    builder.ExportInput(lift_interp.get_input_port(), "phantom.lift")
+
+    # Gravity feed-forward (the UR controller's own gravity compensation, and
+    # the phantom's weight held by its lift).
+    gravity = builder.AddNamedSystem(
+        "gravity_compensation",
+        InverseDynamics(
+            plant, InverseDynamics.InverseDynamicsMode.kGravityCompensation
+        ),
+    )
+    builder.Connect(
+        plant.get_state_output_port(), gravity.get_input_port_estimated_state()
+    )
+    nv = plant.num_velocities()
+    for model, n in ((ur3e, 6), (phantom_model, 1)):
+        select = np.zeros((n, nv))
+        for row, a in enumerate(plant.GetJointActuatorIndices(model)):
+            select[row, plant.get_joint_actuator(a).joint().velocity_start()] = 1.0
+        gain = builder.AddNamedSystem(
+            f"{plant.GetModelInstanceName(model)}_gravity_ff", MatrixGain(select)
+        )
+        builder.Connect(
+            gravity.get_output_port_generalized_force(), gain.get_input_port()
+        )
+        builder.Connect(gain.get_output_port(), plant.get_actuation_input_port(model))
+
+    # Hunt-Crossley tissue force on the tip.
+    p_IP = np.array([0.0, 0.0, params.indenter_length_m])
+    tissue = builder.AddNamedSystem(
+        "tissue_force",
+        TissueForceElement(
+            phantom,
+            indenter_body_index=arm.indenter_body.index(),
+            p_BT=p_IP,
+            phantom_body_index=phantom_body.index(),
+            lookup_resolution_m=params.tissue_lookup_resolution_m,
+            friction_coefficient=params.tissue_friction_coefficient,
+            slip_speed_m_per_s=params.tissue_slip_speed_m_per_s,
+            along_normal=params.tissue_force_along_normal,
+        ),
+    )
+    builder.Connect(
+        plant.get_body_poses_output_port(), tissue.get_body_poses_input_port()
+    )
+    builder.Connect(
+        plant.get_body_spatial_velocities_output_port(),
+        tissue.get_body_spatial_velocities_input_port(),
+    )
+    builder.Connect(
+        tissue.get_spatial_forces_output_port(),
+        plant.get_applied_spatial_force_input_port(),
+    )
+    builder.ExportOutput(tissue.get_force_output_port(), "tissue.force_W")
+    builder.ExportOutput(tissue.get_penetration_output_port(), "tissue.penetration")
+    builder.ExportOutput(tissue.get_surface_z_output_port(), "tissue.surface_z")
+
+    # F/T sensor from the weld's reaction.
+    m_ws, m_i = params.ft_wrench_mass_kg, params.indenter_mass_kg
+    p_SScm = (
+        m_ws * np.array([0, 0, -params.ft_wrench_offset_m / 4])
+        + m_i * np.array([0, 0, 0.4 * params.indenter_length_m])
+    ) / (m_ws + m_i)
+    noise_std = np.concatenate(
+        [np.full(3, params.sensor_torque_noise_std_Nm), params.sensor_noise_std_N]
+    )
+    sensor = builder.AddNamedSystem(
+        "ft_sensor",
+        ForceTorqueSensor(
+            weld_joint_index=arm.sensor_weld.index(),
+            child_body_index=arm.sensor_body.index(),
+            X_CS=RigidTransform(),
+            distal_mass_kg=params.distal_mass_kg,
+            p_SScm=p_SScm,
+            period_s=params.sensor_period_s,
+            lag_samples=int(params.sensor_lag_samples),
+            noise_std=noise_std,
+            bias=np.concatenate([np.zeros(3), params.sensor_bias_N]),
+            gravity_W=[0, 0, -params.gravity_m_per_s2],
+        ),
+    )
+    builder.Connect(
+        plant.get_reaction_forces_output_port(), sensor.get_reaction_forces_input_port()
+    )
+    builder.Connect(
+        plant.get_body_poses_output_port(), sensor.get_body_poses_input_port()
+    )
+    if np.any(noise_std > 0):
+        noise = builder.AddNamedSystem(
+            "ft_sensor_noise",
+            RandomSource(RandomDistribution.kGaussian, 6, params.sensor_period_s),
+        )
+        builder.Connect(noise.get_output_port(), sensor.get_noise_input_port())
+    builder.ExportOutput(sensor.get_force_output_port(), "ft_sensor.force_W")
+    builder.ExportOutput(sensor.get_wrench_output_port(), "ft_sensor.wrench_S")
+
+    # The tip's kinematics come from the tissue element, which computes them
+    # every step anyway.
+    builder.ExportOutput(tissue.get_tip_position_output_port(), "probe.position")
+    builder.ExportOutput(tissue.get_tip_velocity_output_port(), "probe.velocity")
+
+    builder.ExportOutput(plant.get_state_output_port(ur3e), "ur3e.state")
+    demux = builder.AddNamedSystem("phantom_state_demux", Demultiplexer(2, 1))
+    builder.Connect(plant.get_state_output_port(phantom_model), demux.get_input_port())
+    builder.ExportOutput(demux.get_output_port(0), "phantom.z_offset")
+    builder.ExportOutput(plant.get_body_poses_output_port(), "plant.body_poses")
+    builder.ExportOutput(
+        plant.get_contact_results_output_port(), "plant.contact_results"
+    )
+
+    if meshcat is not None:
+        # Local import: the visualization module is needed only with a Meshcat.
+        from pydrake.visualization import AddDefaultVisualization
+
+        AddDefaultVisualization(builder, meshcat=meshcat)
+
+    diagram = builder.Build()
+    diagram.set_name("station")
+    return diagram
+
+
+def station_plant(station: Diagram) -> MultibodyPlant:
+    """The station's MultibodyPlant (subsystem "plant")."""
+    return station.GetSubsystemByName("plant")
+
+
+def set_station_state(
+    station: Diagram, station_context, q, *, phantom_lift_m: float = 0.0
+):
+    """Sets the arm at rest at q (6,) and the phantom at a lift, in a station context."""
+    plant = station_plant(station)
+    plant_context = station.GetMutableSubsystemContext(plant, station_context)
+    ur3e = plant.GetModelInstanceByName("ur3e")
+    plant.SetPositions(plant_context, ur3e, np.asarray(q, float))
+    plant.SetVelocities(plant_context, ur3e, np.zeros(6))
+    servo = station.GetSubsystemByName("ur3e_servo_filter")
+    station.GetMutableSubsystemContext(servo, station_context).SetDiscreteState(
+        joint_servo_rest_state(q)
+    )
+    phantom = plant.GetModelInstanceByName("phantom")
+    plant.SetPositions(plant_context, phantom, [phantom_lift_m])
+    plant.SetVelocities(plant_context, phantom, [0.0])
+
+
+__all__ = ["MakeStation", "set_station_state", "station_plant"]

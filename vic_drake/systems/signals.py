@@ -1,0 +1,69 @@
+"""Layouts of the controller's packed vector ports, each defined once.
+
+Most controller signals are ports of their own. A few vectors stay packed
+(see docs/decisions.md, "Controller signals") and are described here, the
+one place both their writer and their readers take the layout from:
+
+- ``references`` (ForceReferenceSystem -> StiffnessQpSystem): the tick's
+  references, computed with direct feedthrough from the current measurement
+  in one cache entry. One port keeps the QP's update at one evaluation of a
+  Python output per tick (a port per signal would add one Python callback
+  each).
+- ``contact`` (ForceReferenceSystem, state of the last tick): the contact
+  part of ``references``.
+- ``qp_tick`` (StiffnessQpSystem -> EnergyTankSystem): what the QP's last
+  tick used, which the tank integrates within the same tick. One port keeps
+  the tank's step at one port evaluation per tick.
+- ``status`` (StiffnessQpSystem) and ``tank`` (EnergyTankSystem): records
+  logged as one vector each; :data:`STATUS_FIELDS` and :data:`TANK_FIELDS`
+  name their elements in order.
+"""
+
+from __future__ import annotations
+
+#: Elements of the "contact" port, in order: 1 in contact else 0; the
+#: map-based penetration eps = surface_z - z, m; 1 on a non-finite input
+#: else 0; the surface-velocity estimate, m/s.
+CONTACT_FIELDS = ("in_contact", "penetration_m", "fault", "surface_velocity_m_per_s")
+CONTACT_SIZE = len(CONTACT_FIELDS)
+
+#: The "references" port: F_ref (3, N), F_min (3, N), the FDCC target force
+#: (3, N), then the :data:`CONTACT_FIELDS`.
+REFERENCES_SIZE = 9 + CONTACT_SIZE
+REF_FORCE_REFERENCE = slice(0, 3)
+REF_FORCE_MIN = slice(3, 6)
+REF_TARGET_FORCE = slice(6, 9)
+REF_CONTACT = slice(9, REFERENCES_SIZE)
+REF_IN_CONTACT = 9 + CONTACT_FIELDS.index("in_contact")
+REF_PENETRATION = 9 + CONTACT_FIELDS.index("penetration_m")
+REF_FAULT = 9 + CONTACT_FIELDS.index("fault")
+REF_SURFACE_VELOCITY = 9 + CONTACT_FIELDS.index("surface_velocity_m_per_s")
+
+#: The "qp_tick" port: the QP's last tick as the tank integrates it.
+#: e = x_d - x (3, m), e_dot = -x_dot (3, m/s), K (3, N/m), the damping D
+#: the tick used (3, N s/m: 2 zeta sqrt of the previous tick's K), and
+#: 1 when the tick ran the variable stiffness (VS controllers) else 0
+#: (before the first tick, CS and CF: the tank then holds its energy).
+QP_TICK_POSITION_ERROR = slice(0, 3)
+QP_TICK_VELOCITY_ERROR = slice(3, 6)
+QP_TICK_STIFFNESS = slice(6, 9)
+QP_TICK_DAMPING_USED = slice(9, 12)
+QP_TICK_ACTIVE = 12
+QP_TICK_SIZE = 13
+
+#: Elements of the QP system's "status" port, in order.
+STATUS_FIELDS = (
+    "qp_ok",
+    "fallback_count",
+    "fault",
+    "in_contact",
+    "solve_time_s",
+    "penetration_m",
+)
+STATUS_QP_OK = STATUS_FIELDS.index("qp_ok")
+STATUS_FALLBACK_COUNT = STATUS_FIELDS.index("fallback_count")
+
+#: Elements of the tank system's "tank" port, in order: T after the tick, J;
+#: dT/dt, W; sigma (0/1); enabled (0/1).
+TANK_FIELDS = ("T_J", "power_W", "sigma", "enabled")
+TANK_ENERGY = TANK_FIELDS.index("T_J")

@@ -1,0 +1,176 @@
+"""An analytic chest phantom: torso dome, shoulder rise, ribs under soft tissue.
+
+The embedded default when the measured data is absent. Every parameter lives
+in :class:`SyntheticChestParams`. Outside its footprint it clamps like the
+grid phantom: values extend constantly and the gradient across the edge is
+zero.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from vic_drake.errors import VicDrakeError
+from vic_drake.paper import BEST_BETA
+from vic_drake.tissue.phantom.base import Phantom, TissueSample
+
+
+@dataclass(frozen=True)
+class SyntheticChestParams:
+    """Every parameter of the synthetic chest phantom (base frame, SI units).
+
+    The torso is a 33 x 33 x 23 cm block whose top is a smooth dome, placed
+    where the real phantom lay on the rig (the measured map's region sits
+    inside it), so the same scan scenarios run on both. Ribs run along y and
+    are crossed by scans along x, as on the real phantom.
+    """
+
+    center_x_m: float = -0.06  # Torso centre, x.
+    center_y_m: float = -0.36  # Torso centre, y.
+    length_x_m: float = 0.33  # Torso extent along x (head-feet).
+    width_y_m: float = 0.33  # Torso extent along y (left-right).
+    height_m: float = 0.23  # Torso thickness; its base is at top_z_m - height_m.
+    top_z_m: float = 0.112  # Highest surface point, m.
+    curvature_x_per_m: float = 0.5  # Dome: z drops curvature * dx^2 along x.
+    curvature_y_per_m: float = 1.0  # Dome: z drops curvature * dy^2 along y.
+    shoulder_rise_m: float = 0.025  # Height of the shoulder rise in one corner.
+    shoulder_dx_m: float = 0.15  # Shoulder centre relative to the torso centre, x.
+    shoulder_dy_m: float = -0.15  # Shoulder centre relative to the torso centre, y.
+    shoulder_radius_m: float = 0.07  # Gaussian radius of the shoulder rise.
+    # Rib centre lines: x = center_x + offset + bend * (y - center_y)^2.
+    rib_offsets_x_m: tuple[float, ...] = (-0.10, -0.055, -0.01, 0.035, 0.08)
+    rib_bend_per_m: float = 0.6
+    rib_sigma_m: float = 0.006  # Gaussian half-width of a rib's stiffness band.
+    muscle_rib_index: int = 4  # The rib under the pectoral muscle (-1 for none).
+    muscle_factor: float = 0.45  # Fraction of the rib's stiffness rise it keeps.
+    kappa_soft: float = 2700.0  # Soft-tissue kappa, N/m^beta.
+    kappa_rib: float = 9800.0  # Peak kappa over a bare rib, N/m^beta.
+    kappa_texture: float = 0.18  # Relative amplitude of smooth soft-tissue variation.
+    # lambda = lam_ref * (kappa / kappa_ref)^lam_exponent: lambda rises faster
+    # than kappa, as on the measured map. Values chosen from the measured map:
+    # docs/decisions.md, "Synthetic chest parameters".
+    lam_ref: float = 21000.0
+    kappa_ref: float = 2545.0
+    lam_exponent: float = 1.7
+    beta: float = BEST_BETA  # Hunt-Crossley exponent.
+    texture_seed: int = 7  # Seed of the soft-tissue texture (deterministic).
+    texture_modes: int = 6  # Number of sinusoidal texture modes.
+
+    def __post_init__(self):
+        for name in (
+            "length_x_m",
+            "width_y_m",
+            "height_m",
+            "rib_sigma_m",
+            "shoulder_radius_m",
+            "kappa_soft",
+            "kappa_rib",
+            "lam_ref",
+            "kappa_ref",
+            "beta",
+        ):
+            value = getattr(self, name)
+            if not (np.isfinite(value) and value > 0):
+                raise VicDrakeError(
+                    f"SyntheticChestParams.{name} must be > 0, got {value!r}"
+                )
+        if self.kappa_rib < self.kappa_soft:
+            raise VicDrakeError(
+                f"SyntheticChestParams.kappa_rib ({self.kappa_rib}) must be >= "
+                f"kappa_soft ({self.kappa_soft})"
+            )
+        if not 0 <= self.muscle_factor <= 1:
+            raise VicDrakeError(
+                f"SyntheticChestParams.muscle_factor must be in [0, 1], got {self.muscle_factor!r}"
+            )
+        if not -1 <= self.muscle_rib_index < len(self.rib_offsets_x_m):
+            raise VicDrakeError(
+                f"SyntheticChestParams.muscle_rib_index must be -1 or in "
+                f"[0, {len(self.rib_offsets_x_m) - 1}], got {self.muscle_rib_index!r}"
+            )
+        if not 0 <= self.kappa_texture < 1:
+            raise VicDrakeError(
+                f"SyntheticChestParams.kappa_texture must be in [0, 1), got {self.kappa_texture!r}"
+            )
+
+
+class SyntheticChestPhantom(Phantom):
+    """An analytic chest phantom: dome, shoulder, ribs under soft tissue."""
+
+    def __init__(self, params: SyntheticChestParams | None = None):
+        self.params = params or SyntheticChestParams()
+        self.beta = self.params.beta
+        self.name = "synthetic"
+        rng = np.random.default_rng(self.params.texture_seed)
+        n = self.params.texture_modes
+        # Wavelengths of 4-12 cm, random phases and directions.
+        self._tex_k = rng.uniform(2 * np.pi / 0.12, 2 * np.pi / 0.04, n)
+        self._tex_dir = rng.uniform(0, np.pi, n)
+        self._tex_phase = rng.uniform(0, 2 * np.pi, n)
+
+    @property
+    def bounds(self):
+        p = self.params
+        return (
+            p.center_x_m - p.length_x_m / 2,
+            p.center_x_m + p.length_x_m / 2,
+            p.center_y_m - p.width_y_m / 2,
+            p.center_y_m + p.width_y_m / 2,
+        )
+
+    @property
+    def base_z_m(self) -> float:
+        return self.params.top_z_m - self.params.height_m
+
+    def rib_centres_x(self, y) -> np.ndarray:
+        """x of every rib's centre line at y: array (n_ribs, *y.shape)."""
+        p = self.params
+        y = np.asarray(y, float)
+        dy = y - p.center_y_m
+        return np.array(
+            [p.center_x_m + o + p.rib_bend_per_m * dy**2 for o in p.rib_offsets_x_m]
+        )
+
+    def _clamp(self, x, y):
+        x_min, x_max, y_min, y_max = self.bounds
+        x, y = np.broadcast_arrays(np.asarray(x, float), np.asarray(y, float))
+        return np.clip(x, x_min, x_max), np.clip(y, y_min, y_max)
+
+    def _surface(self, x, y):
+        p = self.params
+        dx, dy = x - p.center_x_m, y - p.center_y_m
+        z = p.top_z_m - p.curvature_x_per_m * dx**2 - p.curvature_y_per_m * dy**2
+        r2 = (dx - p.shoulder_dx_m) ** 2 + (dy - p.shoulder_dy_m) ** 2
+        return z + p.shoulder_rise_m * np.exp(-r2 / p.shoulder_radius_m**2)
+
+    def _kappa(self, x, y):
+        p = self.params
+        dx, dy = x - p.center_x_m, y - p.center_y_m
+        tex = np.zeros_like(x)
+        for k, a, ph in zip(self._tex_k, self._tex_dir, self._tex_phase):
+            tex = tex + np.sin(k * (np.cos(a) * dx + np.sin(a) * dy) + ph)
+        tex = tex / np.sqrt(len(self._tex_k) / 2.0)  # about unit RMS
+        soft = p.kappa_soft * (1.0 + p.kappa_texture * np.tanh(tex))
+        rib = np.zeros_like(x)
+        for i, xc in enumerate(self.rib_centres_x(y)):
+            scale = p.muscle_factor if i == p.muscle_rib_index else 1.0
+            rib = np.maximum(
+                rib, scale * np.exp(-0.5 * ((x - xc) / p.rib_sigma_m) ** 2)
+            )
+        return soft + (p.kappa_rib - soft) * rib
+
+    def sample(self, x, y) -> TissueSample:
+        xq, yq = np.broadcast_arrays(np.asarray(x, float), np.asarray(y, float))
+        xc, yc = self._clamp(xq, yq)
+        h = 1e-5
+        gx = (self._surface(xc + h, yc) - self._surface(xc - h, yc)) / (2 * h)
+        gy = (self._surface(xc, yc + h) - self._surface(xc, yc - h)) / (2 * h)
+        x_min, x_max, y_min, y_max = self.bounds
+        gx = np.where((xq >= x_min) & (xq <= x_max), gx, 0.0)
+        gy = np.where((yq >= y_min) & (yq <= y_max), gy, 0.0)
+        kappa = self._kappa(xc, yc)
+        p = self.params
+        lam = p.lam_ref * (kappa / p.kappa_ref) ** p.lam_exponent
+        return TissueSample(self._surface(xc, yc), gx, gy, kappa, lam)
