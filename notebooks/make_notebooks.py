@@ -260,13 +260,18 @@ def main() -> None:
     import argparse
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", default=str(HERE), help="folder to write to (default: here)")
+    parser.add_argument(
+        "--out", default=str(HERE), help="folder to write to (default: here)"
+    )
     out = Path(parser.parse_args().out)
     out.mkdir(parents=True, exist_ok=True)
     for name, cells in NOTEBOOKS.items():
         nb = new_notebook(cells=cells())
-        nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3",
-                                     "language": "python"}
+        nb.metadata["kernelspec"] = {
+            "name": "python3",
+            "display_name": "Python 3",
+            "language": "python",
+        }
         nbformat.write(nb, out / name)
         print(f"wrote {out / name}")
 

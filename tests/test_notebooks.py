@@ -20,8 +20,16 @@ def test_notebooks_are_generated(tmp_path):
 
     import nbformat
 
-    subprocess.run([sys.executable, str(NOTEBOOK_DIR / "make_notebooks.py"), "--out",
-                    str(tmp_path)], check=True, capture_output=True)
+    subprocess.run(
+        [
+            sys.executable,
+            str(NOTEBOOK_DIR / "make_notebooks.py"),
+            "--out",
+            str(tmp_path),
+        ],
+        check=True,
+        capture_output=True,
+    )
     assert sorted(p.name for p in tmp_path.glob("*.ipynb")) == NAMES
     for name in NAMES:
         fresh = nbformat.read(tmp_path / name, as_version=4)
@@ -40,10 +48,19 @@ def test_notebook_runs_short(name, monkeypatch):
     monkeypatch.setenv("VIC_DRAKE_SHORT", "1")
     monkeypatch.setenv("MPLBACKEND", "Agg")
     nb = nbformat.read(NOTEBOOK_DIR / name, as_version=4)
-    client = NotebookClient(nb, timeout=300, kernel_name="python3",
-                            resources={"metadata": {"path": str(NOTEBOOK_DIR)}})
+    client = NotebookClient(
+        nb,
+        timeout=300,
+        kernel_name="python3",
+        resources={"metadata": {"path": str(NOTEBOOK_DIR)}},
+    )
     client.execute()
-    errors = [o for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", [])
-              if o.get("output_type") == "error"]
+    errors = [
+        o
+        for c in nb.cells
+        if c.cell_type == "code"
+        for o in c.get("outputs", [])
+        if o.get("output_type") == "error"
+    ]
     assert not errors
     assert os.environ["VIC_DRAKE_SHORT"] == "1"

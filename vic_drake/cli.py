@@ -25,7 +25,9 @@ def build_parser() -> argparse.ArgumentParser:
         prog="vic-drake",
         description="Passive variable impedance control for robotic ultrasonography, on Drake.",
     )
-    parser.add_argument("--version", action="version", version=f"vic-drake {__version__}")
+    parser.add_argument(
+        "--version", action="version", version=f"vic-drake {__version__}"
+    )
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
     subparsers.required = True
     for name in COMMAND_MODULES:

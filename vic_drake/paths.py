@@ -18,6 +18,8 @@ from vic_drake.errors import DataNotFoundError
 DATA_ENV_VAR = "VIC_DRAKE_DATA"
 PROJECT_ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_DATA_DIR = PROJECT_ROOT.parent / "shared" / "data"
+#: The scenario files of the paper's runs (the source of truth of reproduce).
+DIAGRAMS_DIR = PROJECT_ROOT / "diagrams"
 
 
 def resolve_data_dir(data_dir: str | os.PathLike | None = None) -> Path:

@@ -227,9 +227,15 @@ def read_phantom_map(map_dir: str | os.PathLike) -> PhantomMapData:
 
     x, y = load("x.txt"), load("y.txt")
     if np.any(np.diff(x) <= 0) or np.any(np.diff(y) <= 0):
-        raise VicDrakeError(f"phantom map {str(map_dir)!r}: x.txt and y.txt must increase")
+        raise VicDrakeError(
+            f"phantom map {str(map_dir)!r}: x.txt and y.txt must increase"
+        )
     fields = {}
-    for key, name in (("z_m", "z.txt"), ("kappa", "stiffness.txt"), ("lam", "damping.txt")):
+    for key, name in (
+        ("z_m", "z.txt"),
+        ("kappa", "stiffness.txt"),
+        ("lam", "damping.txt"),
+    ):
         values = load(name)
         if values.size != x.size * y.size:
             raise VicDrakeError(

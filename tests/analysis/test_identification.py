@@ -58,7 +58,9 @@ def test_force_loop_gain_recovers_a_known_integral_loop():
     assert est["gain_m_per_s_per_N"] == pytest.approx(g, rel=0.02)
     assert est["offset_N"] == pytest.approx(bias, abs=0.02)
     assert est["r2"] > 0.99
-    short = estimate_force_loop_gain(df.iloc[:50], stiffness_z_N_per_m=k, force_ref_z_N=0.0)
+    short = estimate_force_loop_gain(
+        df.iloc[:50], stiffness_z_N_per_m=k, force_ref_z_N=0.0
+    )
     assert np.isnan(short["gain_m_per_s_per_N"])
     with pytest.raises(VicDrakeError, match="stiffness_z_N_per_m"):
         estimate_force_loop_gain(df)

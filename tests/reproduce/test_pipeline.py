@@ -10,9 +10,13 @@ from vic_drake.reproduce import ReproduceOptions, reproduce
 
 @pytest.mark.realdata
 def test_real_logs_claims_and_report(tmp_path, data_dir):
-    result = reproduce(ReproduceOptions(
-        out_dir=tmp_path, data_dir=data_dir,
-        stages=("real_scans", "claims", "report")))
+    result = reproduce(
+        ReproduceOptions(
+            out_dir=tmp_path,
+            data_dir=data_dir,
+            stages=("real_scans", "claims", "report"),
+        )
+    )
     claims = json.loads((tmp_path / "claims.json").read_text())
     assert list(claims) == [f"C{i}" for i in range(1, 8)]
     for c in claims.values():

@@ -22,11 +22,26 @@ def _content():
     fig, ax = plt.subplots()
     ax.plot([0, 1], [1, 0])
     claims = {
-        "C1": {"statement": "HC beats KV", "paper": {"kv": 0.066}, "sim": {"kv": 0.07},
-               "real": None, "pass": True, "pass_sim": True, "pass_real": None,
-               "detail": "why <b>"},
-        "C2": {"statement": "decays", "paper": "exp", "sim": None, "real": None,
-               "pass": False, "pass_sim": None, "pass_real": None, "detail": "no data"},
+        "C1": {
+            "statement": "HC beats KV",
+            "paper": {"kv": 0.066},
+            "sim": {"kv": 0.07},
+            "real": None,
+            "pass": True,
+            "pass_sim": True,
+            "pass_real": None,
+            "detail": "why <b>",
+        },
+        "C2": {
+            "statement": "decays",
+            "paper": "exp",
+            "sim": None,
+            "real": None,
+            "pass": False,
+            "pass_sim": None,
+            "pass_real": None,
+            "detail": "no data",
+        },
     }
     return ReportContent(
         claims=claims,
@@ -57,7 +72,9 @@ def test_format_value():
     assert format_value(0.0123456) == "0.01235"
     assert format_value({"a": 1, "b": [1.5, None]}) == "a: 1\nb: [1.5, —]"
     assert "n/a" in format_value(float("nan"))
-    assert format_value({"log": {"a": 1, "b": 2}, "c": 3}) == "log:\n  a: 1\n  b: 2\nc: 3"
+    assert (
+        format_value({"log": {"a": 1, "b": 2}, "c": 3}) == "log:\n  a: 1\n  b: 2\nc: 3"
+    )
 
 
 def test_render_without_claims():

@@ -113,7 +113,9 @@ def test_reference_system_ports_and_layout(phantom):
     refs = system.get_references_output_port().Eval(context)
     expected = force_references(contact=True, kappa=KAPPA, lam=LAM, eps_dot=-V_WP[2],
                                 beta=BETA, ref=p.reference, qp=p.qp)  # fmt: skip
-    np.testing.assert_allclose(refs[REF_FORCE_REFERENCE], expected.force_ref, rtol=1e-14)
+    np.testing.assert_allclose(
+        refs[REF_FORCE_REFERENCE], expected.force_ref, rtol=1e-14
+    )
     np.testing.assert_allclose(refs[REF_FORCE_MIN], expected.force_min, rtol=1e-14)
     np.testing.assert_array_equal(refs[REF_TARGET_FORCE], expected.target_force)
     assert refs[REF_IN_CONTACT] == 1.0 and refs[REF_FAULT] == 0.0
@@ -183,7 +185,9 @@ def test_qp_system_publishes_what_its_tick_used():
     # Before the first tick: K_min, no tick for the tank.
     record = system.get_qp_tick_output_port().Eval(context)
     assert record[QP_TICK_ACTIVE] == 0.0
-    np.testing.assert_array_equal(system.get_stiffness_output_port().Eval(context), k_min)
+    np.testing.assert_array_equal(
+        system.get_stiffness_output_port().Eval(context), k_min
+    )
     np.testing.assert_array_equal(record[QP_TICK_STIFFNESS], k_min)
     np.testing.assert_allclose(record[QP_TICK_DAMPING_USED], d0, rtol=1e-15)
     tick(system, context)
@@ -242,8 +246,17 @@ def test_tank_system_ports_and_one_tick():
     p = params("vs-vf")
     system = EnergyTankSystem(p)
     assert ports(system, "input") == {"qp_tick": QP_TICK_SIZE}
-    assert ports(system, "output") == {"x_t": 1, "tank": len(TANK_FIELDS), "tank_energy": 1}
-    e, e_dot, k, d = (0.0, 0.0, -0.01), (0.0, 0.0, 0.02), (300.0, 300.0, 600.0), (24.0, 24.0, 30.0)
+    assert ports(system, "output") == {
+        "x_t": 1,
+        "tank": len(TANK_FIELDS),
+        "tank_energy": 1,
+    }
+    e, e_dot, k, d = (
+        (0.0, 0.0, -0.01),
+        (0.0, 0.0, 0.02),
+        (300.0, 300.0, 600.0),
+        (24.0, 24.0, 30.0),
+    )
     context = _tank_context(system, e, e_dot, k, d, 1.0)
     k_min = tuple(p.qp.stiffness_min_N_per_m)
     step = tank_step(0.5, e, e_dot, k, k_min, d, p.period_s, p.tank)
@@ -259,7 +272,9 @@ def test_tank_system_ports_and_one_tick():
 def test_tank_system_inactive_tick_keeps_the_energy():
     p = params("cs")
     system = EnergyTankSystem(p)
-    context = _tank_context(system, (0.01,) * 3, (0.02,) * 3, (400.0,) * 3, (28.0,) * 3, 0.0)
+    context = _tank_context(
+        system, (0.01,) * 3, (0.02,) * 3, (400.0,) * 3, (28.0,) * 3, 0.0
+    )
     expected = TankStep(0.5, 0.0, 0.0, False)
     np.testing.assert_array_equal(system.get_tank_output_port().Eval(context),
                                   [expected.energy_J, 0.0, 0.0, 0.0])  # fmt: skip

@@ -47,7 +47,6 @@ CANONICAL_COLUMNS = (
 )
 
 
-
 def require_columns(df: pd.DataFrame, *columns: str) -> None:
     """Raises VicDrakeError naming the canonical columns df lacks."""
     missing = [c for c in columns if c not in df.columns]

@@ -4,6 +4,7 @@ lateral friction and normal tilt, and the phantom's lift under a disturbance.
 
 import numpy as np
 import pandas as pd
+from scipy.signal import savgol_filter
 
 from vic_drake.analysis.columns import require_columns
 from vic_drake.analysis.contact import contact_mask, pressing_force_N
@@ -13,8 +14,6 @@ from vic_drake.paper import CONTACT_THRESHOLD_N
 
 def _smoothed_rate(t: np.ndarray, v: np.ndarray, smooth_s: float) -> np.ndarray:
     """d v / d t after a cubic Savitzky-Golay smoothing over about smooth_s."""
-    from scipy.signal import savgol_filter
-
     dt = float(np.median(np.diff(t)))
     window = max(5, int(round(smooth_s / dt)) | 1)
     return np.gradient(savgol_filter(v, window, 3), t)
@@ -124,8 +123,15 @@ def estimate_tissue_friction(
         dict with ``tilt`` (a), ``friction_coefficient`` (mu), ``r2`` and
         ``samples``; NaN figures when fewer than 100 samples qualify.
     """
-    require_columns(df, "t_s", "x_m", "y_m", "force_sensor_x_N", "force_sensor_y_N",
-             "force_sensor_z_N")
+    require_columns(
+        df,
+        "t_s",
+        "x_m",
+        "y_m",
+        "force_sensor_x_N",
+        "force_sensor_y_N",
+        "force_sensor_z_N",
+    )
     nan = {"tilt": np.nan, "friction_coefficient": np.nan, "r2": np.nan, "samples": 0}
     t = df["t_s"].to_numpy(float)
     if len(t) < 100:
@@ -143,9 +149,7 @@ def estimate_tissue_friction(
     gx, gy = (np.asarray(g, float) for g in phantom.surface_gradient(x[use], y[use]))
     f, vx, vy = force[use], vx[use], vy[use]
     scale = f / np.sqrt(vx * vx + vy * vy + slip_speed_m_per_s**2)
-    a = np.column_stack(
-        [np.r_[-gx * f, -gy * f], np.r_[-scale * vx, -scale * vy]]
-    )
+    a = np.column_stack([np.r_[-gx * f, -gy * f], np.r_[-scale * vx, -scale * vy]])
     b = np.r_[fx_w[use], fy_w[use]]
     (tilt, mu), *_ = np.linalg.lstsq(a, b, rcond=None)
     resid = b - a @ np.array([tilt, mu])

@@ -90,7 +90,9 @@ def compare_with_phantom(
     def inside(values):
         return tuple(float(v) for v in np.sort(values) if lo <= v <= hi)
 
-    found = inside(find_ribs(xs, band_profile(xs, ys, tmap.kappa, y_line, band_m)).position_m)
+    found = inside(
+        find_ribs(xs, band_profile(xs, ys, tmap.kappa, y_line, band_m)).position_m
+    )
     if hasattr(phantom, "rib_centres_x"):
         true = inside(np.asarray(phantom.rib_centres_x(y_line)).ravel())
     else:

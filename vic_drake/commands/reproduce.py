@@ -24,16 +24,21 @@ def register(subparsers) -> None:
     )
     parser.add_argument("--out", required=True, metavar="DIR", help="output folder")
     parser.add_argument(
-        "--quick", action="store_true",
+        "--quick",
+        action="store_true",
         help="shorter scans and a coarser map (under 5 minutes on 2 cores)",
     )
     parser.add_argument(
-        "--phantom", choices=("auto", "measured", "synthetic"), default="auto",
+        "--phantom",
+        choices=("auto", "measured", "synthetic"),
+        default="auto",
         help="phantom of the simulated scans (auto: the measured map when the data is "
         "there, else the synthetic chest)",
     )
     parser.add_argument(
-        "--stages", default=None, metavar="LIST",
+        "--stages",
+        default=None,
+        metavar="LIST",
         help="comma-separated stages to run (default: all)",
     )
     add_data_dir_option(parser)
@@ -49,8 +54,12 @@ def _run(args: argparse.Namespace) -> int:
     if args.stages:
         stages = tuple(s.strip() for s in args.stages.split(",") if s.strip())
     options = ReproduceOptions(
-        out_dir=args.out, data_dir=args.data_dir, quick=args.quick, phantom=args.phantom,
-        stages=stages, progress=Progress(enabled=not (args.quiet or args.json)),
+        out_dir=args.out,
+        data_dir=args.data_dir,
+        quick=args.quick,
+        phantom=args.phantom,
+        stages=stages,
+        progress=Progress(enabled=not (args.quiet or args.json)),
     )
     result = reproduce(options)
     summary = result.summary()

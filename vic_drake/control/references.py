@@ -181,4 +181,3 @@ def scalar_sampler(phantom):
     a GridPhantom, a 0.5 mm rasterization otherwise).
     """
     return phantom.point_lookup()
-

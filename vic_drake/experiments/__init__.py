@@ -43,6 +43,7 @@ from vic_drake.experiments.paper_scenarios import (
     DISTURBANCE_DELAYS_S,
     REAL_EXPERIMENTS,
     disturbance_lifts,
+    load_diagram,
     paper_scenarios,
     real_experiment_scenario,
     scan_start_s,
@@ -123,5 +124,6 @@ __all__ = [
     "set_initial_state",
     "simulate_palpations",
     "synthetic_scenario",
+    "load_diagram",
     "write_paper_scenarios",
 ]

@@ -27,13 +27,14 @@ from vic_drake.experiments.real_logs import (
     with_z_gains,
 )
 from vic_drake.paper import CONTROLLERS, DISTURBANCE_CONTROLLERS
-from vic_drake.paths import require_data_dir
+from vic_drake.paths import DIAGRAMS_DIR, require_data_dir
 from vic_drake.realdata import read_bag
 from vic_drake.scenario import (
     DisturbanceConfig,
     PhantomLift,
     Scenario,
     TrajectoryConfig,
+    load_scenario,
     save_scenario,
 )
 from vic_drake.tissue.phantom import load_phantom
@@ -185,6 +186,26 @@ def paper_scenarios(*, data_dir=None, include_real: bool = True) -> dict[str, Sc
     return out
 
 
+def load_diagram(name: str) -> Scenario:
+    """The scenario ``diagrams/<name>.yaml``, as the runs of the paper load it.
+
+    ``diagrams/`` is the source of truth of the paper's runs: ``reproduce``
+    builds its scans from these files, and the tests check that each file
+    agrees with :func:`paper_scenarios` (written by
+    :func:`write_paper_scenarios`).
+
+    Raises:
+        VicDrakeError: no such file; the message lists the files there are.
+    """
+    path = DIAGRAMS_DIR / f"{name}.yaml"
+    if not path.is_file():
+        known = sorted(p.stem for p in DIAGRAMS_DIR.glob("*.yaml"))
+        raise VicDrakeError(
+            f"no scenario file {str(path)!r}; diagrams/ holds {known or 'nothing'}"
+        )
+    return load_scenario(path)
+
+
 def write_paper_scenarios(
     directory, *, data_dir=None, include_real: bool = True
 ) -> list[Path]:
@@ -202,6 +223,7 @@ def write_paper_scenarios(
 
 __all__ = [
     "DISTURBANCE_DELAYS_S",
+    "load_diagram",
     "REAL_EXPERIMENTS",
     "disturbance_lifts",
     "paper_scenarios",

@@ -42,8 +42,13 @@ class StageRecord:
         return "ok" if self.ok else ("skipped" if self.skipped else "failed")
 
     def as_dict(self) -> dict:
-        return {"name": self.name, "ok": self.ok, "status": self.status,
-                "wall_s": round(self.wall_s, 2), "error": self.error}
+        return {
+            "name": self.name,
+            "ok": self.ok,
+            "status": self.status,
+            "wall_s": round(self.wall_s, 2),
+            "error": self.error,
+        }
 
 
 @dataclass
@@ -112,5 +117,6 @@ def _write_log(ctx: RunContext, name: str, df: pd.DataFrame, config: dict) -> No
     logs = ctx.out_dir / "logs"
     logs.mkdir(parents=True, exist_ok=True)
     df.to_parquet(logs / f"{name}.parquet", index=False)
-    (logs / f"{name}.yaml").write_text(yaml.safe_dump(plain(config), sort_keys=False),
-                                       encoding="utf-8")
+    (logs / f"{name}.yaml").write_text(
+        yaml.safe_dump(plain(config), sort_keys=False), encoding="utf-8"
+    )

@@ -78,8 +78,9 @@ def run_pipeline(ctx: RunContext) -> None:
             rec = StageRecord(name, True, time.perf_counter() - t0)
             ctx.progress(f"[{i + 1}/{len(names)}] {name} done in {rec.wall_s:.1f} s")
         except StageSkipped as exc:
-            rec = StageRecord(name, False, time.perf_counter() - t0, f"skipped: {exc}",
-                              skipped=True)
+            rec = StageRecord(
+                name, False, time.perf_counter() - t0, f"skipped: {exc}", skipped=True
+            )
             ctx.progress(f"[{i + 1}/{len(names)}] {name} skipped: {exc}")
         except Exception as exc:  # noqa: BLE001 - a failed stage is reported, not fatal
             msg = f"{type(exc).__name__}: {exc}"
@@ -101,8 +102,9 @@ def reproduce(options: ReproduceOptions) -> ReproduceResult:
     try:
         options.out_dir.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise VicDrakeError(f"cannot create the output folder {str(options.out_dir)!r}: "
-                            f"{exc.strerror}") from None
+        raise VicDrakeError(
+            f"cannot create the output folder {str(options.out_dir)!r}: {exc.strerror}"
+        ) from None
     err_log = options.out_dir / "logs" / "errors.txt"
     if err_log.exists():
         err_log.unlink()
@@ -111,9 +113,19 @@ def reproduce(options: ReproduceOptions) -> ReproduceResult:
     run_pipeline(ctx)
     wall = time.perf_counter() - t0
     (options.out_dir / "run.json").write_text(
-        json.dumps({"wall_s": round(wall, 2), "quick": options.quick,
-                    "stages": [r.as_dict() for r in ctx.records]}, indent=2) + "\n",
-        encoding="utf-8")
+        json.dumps(
+            {
+                "wall_s": round(wall, 2),
+                "quick": options.quick,
+                "stages": [r.as_dict() for r in ctx.records],
+            },
+            indent=2,
+        )
+        + "\n",
+        encoding="utf-8",
+    )
     claims = (ctx.results.get("claims") or {}).get("claims", {})
     report = (ctx.results.get("report") or {}).get("path")
-    return ReproduceResult(options.out_dir, claims, ctx.records, wall, report, ctx.results)
+    return ReproduceResult(
+        options.out_dir, claims, ctx.records, wall, report, ctx.results
+    )

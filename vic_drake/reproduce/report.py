@@ -47,7 +47,9 @@ class ReportFigure:
             buf = io.BytesIO()
             self.png.savefig(buf, format="png", dpi=110, bbox_inches="tight")
             return buf.getvalue()
-        raise TypeError(f"ReportFigure.png must be bytes, a path or a Figure, got {type(self.png)}")
+        raise TypeError(
+            f"ReportFigure.png must be bytes, a path or a Figure, got {type(self.png)}"
+        )
 
 
 @dataclass
@@ -166,19 +168,25 @@ def claims_table_html(claims: Mapping[str, Mapping]) -> str:
             f"{_pass_cell(bool(c.get('pass')))}"
             "</tr>"
         )
-    head = ("<tr><th>id</th><th>claim</th><th>paper</th><th>simulation</th>"
-            "<th>real measurement</th><th>sim</th><th>real</th><th>pass</th></tr>")
+    head = (
+        "<tr><th>id</th><th>claim</th><th>paper</th><th>simulation</th>"
+        "<th>real measurement</th><th>sim</th><th>real</th><th>pass</th></tr>"
+    )
     return f"<table>{head}{''.join(rows)}</table>"
 
 
 def table_html(table: ReportTable) -> str:
     head = "".join(f"<th>{html.escape(str(c))}</th>" for c in table.columns)
     body = "".join(
-        "<tr>" + "".join(f"<td>{html.escape(format_value(v))}</td>" for v in row) + "</tr>"
+        "<tr>"
+        + "".join(f"<td>{html.escape(format_value(v))}</td>" for v in row)
+        + "</tr>"
         for row in table.rows
     )
     cap = f'<p class="small">{html.escape(table.caption)}</p>' if table.caption else ""
-    return f"<h3>{html.escape(table.title)}</h3><table><tr>{head}</tr>{body}</table>{cap}"
+    return (
+        f"<h3>{html.escape(table.title)}</h3><table><tr>{head}</tr>{body}</table>{cap}"
+    )
 
 
 def figure_html(fig: ReportFigure) -> str:
@@ -228,14 +236,23 @@ def render_report(content: ReportContent) -> str:
     if content.stages:
         parts.append("<h2>Stages</h2>")
         rows = [
-            [s.get("name"), s.get("status") or ("ok" if s.get("ok") else "failed"),
-             s.get("wall_s"),
-             s.get("error") or ""]
+            [
+                s.get("name"),
+                s.get("status") or ("ok" if s.get("ok") else "failed"),
+                s.get("wall_s"),
+                s.get("error") or "",
+            ]
             for s in content.stages
         ]
-        parts.append(table_html(ReportTable("Pipeline stages", ["stage", "status",
-                                                                 "wall time [s]", "note"],
-                                            rows)))
+        parts.append(
+            table_html(
+                ReportTable(
+                    "Pipeline stages",
+                    ["stage", "status", "wall time [s]", "note"],
+                    rows,
+                )
+            )
+        )
     if content.metadata:
         parts.append("<h2>Run</h2><table>")
         parts.extend(

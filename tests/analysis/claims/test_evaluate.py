@@ -1,6 +1,5 @@
 """All claims together: the JSON form of claims.json."""
 
-
 from vic_drake.analysis import claims as C
 
 

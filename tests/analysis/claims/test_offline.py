@@ -9,8 +9,9 @@ from vic_drake.errors import VicDrakeError
 
 
 def _res(kv, **hc):
-    return C.ModelResiduals(kv, {float(k.replace("b", "").replace("_", ".")): v
-                                 for k, v in hc.items()})
+    return C.ModelResiduals(
+        kv, {float(k.replace("b", "").replace("_", ".")): v for k, v in hc.items()}
+    )
 
 
 def test_c1_paper_table_passes_and_wrong_best_beta_fails():
@@ -72,8 +73,9 @@ def _rib_map(amplitudes, base=5000.0):
     x = np.linspace(-0.1, 0.1, 201)
     y = np.linspace(-0.05, 0.05, 21)
     centres = np.linspace(-0.07, 0.07, len(amplitudes))
-    prof = base + sum(a * np.exp(-0.5 * ((x - c) / 0.006) ** 2)
-                      for a, c in zip(amplitudes, centres))
+    prof = base + sum(
+        a * np.exp(-0.5 * ((x - c) / 0.006) ** 2) for a, c in zip(amplitudes, centres)
+    )
     return x, y, np.repeat(prof[:, None], y.size, axis=1)
 
 

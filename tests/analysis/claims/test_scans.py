@@ -14,7 +14,9 @@ def _scan(force_pressing, *, t=None, z_d=0.085, ref=None, lift_at=None, **cols):
     zd = np.full(n, z_d)
     if lift_at is not None:
         zd[t >= lift_at] = z_d + 0.05
-    df = pd.DataFrame({"t_s": t, "z_d_m": zd, "force_sensor_z_N": -np.asarray(force_pressing)})
+    df = pd.DataFrame(
+        {"t_s": t, "z_d_m": zd, "force_sensor_z_N": -np.asarray(force_pressing)}
+    )
     if ref is not None:
         df["force_ref_z_N"] = -np.broadcast_to(ref, (n,))
     for k, v in cols.items():
@@ -28,11 +30,15 @@ def test_scan_metrics_rmse_range_and_lift_off():
     f[t >= 10.5] = 0.0  # lifted off
     m = C.scan_metrics(_scan(f, t=t, ref=7.0, lift_at=10.0))
     w = (t >= 1.0) & (t < 10.0)
-    assert m["force_rmse_N"] == pytest.approx(np.sqrt(np.mean((f[w] - 7) ** 2)), rel=1e-9)
+    assert m["force_rmse_N"] == pytest.approx(
+        np.sqrt(np.mean((f[w] - 7) ** 2)), rel=1e-9
+    )
     assert m["force_range_N"] == pytest.approx(np.ptp(np.percentile(f[w], [2, 98])))
     assert m["lifted_off"] is True
     pressing = C.scan_metrics(_scan(7 + 0 * t, t=t, ref=7.0, lift_at=10.0))
-    assert pressing["lifted_off"] is False and pressing["force_rmse_N"] == pytest.approx(0)
+    assert pressing["lifted_off"] is False and pressing[
+        "force_rmse_N"
+    ] == pytest.approx(0)
     no_ref = C.scan_metrics(_scan(f, t=t, ref=0.0, lift_at=10.0))
     assert "force_rmse_N" not in no_ref and no_ref["force_range_N"] > 0
 
@@ -47,9 +53,15 @@ def test_c4_and_c5_thresholds():
     cf = {"force_rmse_N": 0.55, "lifted_off": False}
     cs = {"force_range_N": 2.5}
     assert C.claim_c4({"vs-cf": vscf, "cf": cf}, None).passed  # 0.6/0.55 = 1.09
-    assert not C.claim_c4({"vs-cf": {**vscf, "force_rmse_N": 0.7}, "cf": cf}, None).passed
-    assert not C.claim_c4({"vs-cf": vscf, "cf": {**cf, "lifted_off": True}}, None).passed
-    assert not C.claim_c4({"vs-cf": {**vscf, "lifted_off": False}, "cf": cf}, None).passed
+    assert not C.claim_c4(
+        {"vs-cf": {**vscf, "force_rmse_N": 0.7}, "cf": cf}, None
+    ).passed
+    assert not C.claim_c4(
+        {"vs-cf": vscf, "cf": {**cf, "lifted_off": True}}, None
+    ).passed
+    assert not C.claim_c4(
+        {"vs-cf": {**vscf, "lifted_off": False}, "cf": cf}, None
+    ).passed
     assert C.claim_c5({"cs": cs, "vs-cf": vscf}, None).passed
     assert not C.claim_c5({"cs": {"force_range_N": 1.9}, "vs-cf": vscf}, None).passed
     assert not C.claim_c5({"cs": cs}, None).passed  # VS-CF missing: not evaluated
@@ -66,11 +78,21 @@ def test_c6_penetration_and_cap():
     assert m["penetration_error_off_ribs_median_m"] == pytest.approx(0.0005)
     assert m["force_on_ribs_p99_N"] == pytest.approx(9.0)
     assert C.claim_c6(m, None).passed
-    over = C.scan_metrics(_scan(np.where(on, 11.0, 6.0), t=t, ref=ref, force_min_z_N=-9.0,
-                                penetration_m=pen))
+    over = C.scan_metrics(
+        _scan(
+            np.where(on, 11.0, 6.0), t=t, ref=ref, force_min_z_N=-9.0, penetration_m=pen
+        )
+    )
     assert not C.claim_c6(over, None).passed
-    deep = C.scan_metrics(_scan(f, t=t, ref=ref, force_min_z_N=-9.0,
-                                penetration_m=np.where(on, 0.004, 0.012)))
+    deep = C.scan_metrics(
+        _scan(
+            f,
+            t=t,
+            ref=ref,
+            force_min_z_N=-9.0,
+            penetration_m=np.where(on, 0.004, 0.012),
+        )
+    )
     assert not C.claim_c6(deep, None).passed
 
 
@@ -80,9 +102,16 @@ def _disturbed(peak=8.0, k_lost=100.0, power_min=-0.09, tank_min=0.45):
     f = np.where(lost, 0.0, 7.0)
     f[np.argmin(np.abs(t - 5.2))] = peak
     k = np.where(lost, k_lost, 500.0)
-    return C.scan_metrics(_scan(f, t=t, ref=7.0, stiffness_z_N_per_m=k,
-                                tank_energy_J=np.linspace(0.6, tank_min, t.size),
-                                tank_power_W=np.linspace(0, power_min, t.size)))
+    return C.scan_metrics(
+        _scan(
+            f,
+            t=t,
+            ref=7.0,
+            stiffness_z_N_per_m=k,
+            tank_energy_J=np.linspace(0.6, tank_min, t.size),
+            tank_power_W=np.linspace(0, power_min, t.size),
+        )
+    )
 
 
 def test_c7_passes_and_each_check_can_fail():
@@ -91,8 +120,12 @@ def test_c7_passes_and_each_check_can_fail():
     assert good["n_contact_losses"] == 1
     assert good["fraction_at_k_min_during_loss"] == pytest.approx(1.0)
     assert C.claim_c7({"vs-vf": good, **others}, None).passed
-    for bad in (_disturbed(peak=15.0), _disturbed(k_lost=300.0),
-                _disturbed(power_min=-0.2), _disturbed(tank_min=0.3)):
+    for bad in (
+        _disturbed(peak=15.0),
+        _disturbed(k_lost=300.0),
+        _disturbed(power_min=-0.2),
+        _disturbed(tank_min=0.3),
+    ):
         claim = C.claim_c7({"vs-vf": bad, **others}, None)
         assert not claim.passed, claim.sim["checks"]
 

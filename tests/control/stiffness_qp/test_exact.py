@@ -37,6 +37,7 @@ def test_interior_optimum_closed_form(osqp):
     assert active_constraint_names(sol.active) == ["k_min_x", "k_min_y"]
     assert osqp.solve(p).stiffness == pytest.approx(sol.stiffness, abs=1e-6)
 
+
 def test_one_active_bound_k_max(osqp, clarabel):
     # Needs 1400 N/m for 7 N; with a small R the optimum is capped at K_max.
     p = problem((0.0, 0.0, -0.005), qp=StiffnessQpParams(r_weight=[1e-5] * 3))
@@ -50,12 +51,14 @@ def test_one_active_bound_k_max(osqp, clarabel):
         assert s.success and s.stiffness == pytest.approx(sol.stiffness, abs=tol)
         assert s.active & active_bit("k_max", 2)
 
+
 def test_one_active_force_row():
     # F_min,z = -4 N with e_z = -0.02: k_z <= 200 N/m keeps F_ext >= F_min.
     p = problem((0.0, 0.0, -0.02), f_min=(-15, -15, -4.0))
     sol = solve_stiffness_qp_exact(p)
     assert sol.stiffness[2] == pytest.approx(200.0, rel=1e-14)
     assert active_constraint_names(sol.active)[-1] == "f_min_z"
+
 
 def test_one_active_tank_energy_row(osqp, clarabel):
     # z error shrinks (e_z e_dot_z < 0 drains the tank when K_z > K_min); T just above T_min.
@@ -73,6 +76,7 @@ def test_one_active_tank_energy_row(osqp, clarabel):
     for other in (osqp, clarabel):
         assert other.solve(p).stiffness[2] == pytest.approx(k_z, abs=1e-4)
 
+
 def test_one_active_power_row():
     e, e_dot = (0.0, 0.0, -0.02), (0.0, 0.0, 0.05)
     p = problem(e, e_dot, damping=ZERO, energy=0.9)
@@ -83,12 +87,14 @@ def test_one_active_power_row():
     assert sol.stiffness[2] == pytest.approx(k_z, rel=1e-12)
     assert sol.active & ACTIVE_TANK_POWER
 
+
 def test_infeasible_returns_k_min(osqp, clarabel):
     # F_min,z above anything K can produce with e_z < 0 and no velocity.
     p = problem((0.0, 0.0, -0.02), f_min=(-15, -15, 1.0))
     for solve in (solve_stiffness_qp_exact, osqp.solve, clarabel.solve):
         sol = solve(p)
         assert not sol.success and sol.stiffness == K_MIN
+
 
 @settings(max_examples=300, deadline=None)
 @given(p=random_problems())

@@ -27,6 +27,7 @@ def test_program_is_built_once(osqp):
     assert prog.linear_constraints()[0].evaluator().num_constraints() == 8
     assert rows.evaluator().GetDenseA()[5, 2] != 0.0  # Updated in place: z force row.
 
+
 @settings(max_examples=300, deadline=None)
 @given(p=random_problems())
 def test_mathematical_program_matches_exact_oracle(osqp, p):
@@ -50,6 +51,7 @@ def test_mathematical_program_matches_exact_oracle(osqp, p):
         <= stiffness_qp_cost(p, mp.stiffness) * (1 + 1e-9) + 1e-9
     )
 
+
 @settings(max_examples=60, deadline=None)
 @given(p=random_problems())
 def test_clarabel_matches_exact_oracle(clarabel, p):
@@ -58,6 +60,7 @@ def test_clarabel_matches_exact_oracle(clarabel, p):
     assert mp.success == exact.success
     if exact.success:
         assert np.allclose(mp.stiffness, exact.stiffness, atol=0.5, rtol=0)
+
 
 def test_unknown_solver_is_a_clear_error():
     from vic_drake.errors import VicDrakeError

@@ -9,8 +9,14 @@ def test_offline_sim_stage_evaluates_c1_and_c2(tmp_path, monkeypatch):
     """Palpations simulated on the synthetic chest (no data needed)."""
     monkeypatch.setenv("VIC_DRAKE_DATA", str(tmp_path / "no_data"))
     out = tmp_path / "out"
-    result = reproduce(ReproduceOptions(out_dir=out, quick=True, phantom="synthetic",
-                                        stages=("offline_sim", "claims", "report")))
+    result = reproduce(
+        ReproduceOptions(
+            out_dir=out,
+            quick=True,
+            phantom="synthetic",
+            stages=("offline_sim", "claims", "report"),
+        )
+    )
     c1, c2 = result.claims["C1"], result.claims["C2"]
     assert c1["pass_sim"] is True and c1["sim"]["best_beta"] == pytest.approx(1.35)
     assert c1["real"] is None and c1["pass_real"] is None

@@ -13,11 +13,18 @@ def test_replay_scan_writes_an_animation():
     from vic_drake.station import initial_q_for_tip
     from vic_drake.tissue import load_phantom
 
-    scenario = scan_scenario("vs-vf", disturbed=False, phantom_kind="synthetic", quick=True)
+    scenario = scan_scenario(
+        "vs-vf", disturbed=False, phantom_kind="synthetic", quick=True
+    )
     q0 = initial_q_for_tip(np.array([0.036, -0.36, 0.11]), scenario.station)
     t = np.linspace(0, 0.4, 11)
-    df = pd.DataFrame({"t_s": t, "phantom_lift_m": 0.01 * t,
-                       **{f"q_cmd_{i}_rad": np.full(t.size, q0[i]) for i in range(6)}})
+    df = pd.DataFrame(
+        {
+            "t_s": t,
+            "phantom_lift_m": 0.01 * t,
+            **{f"q_cmd_{i}_rad": np.full(t.size, q0[i]) for i in range(6)},
+        }
+    )
     html = replay_scan(df, scenario, phantom=load_phantom("synthetic"), fps=20.0)
     import base64
     import re
@@ -26,5 +33,8 @@ def test_replay_scan_writes_an_animation():
     blobs = re.findall(r'fetch\("data:application/octet-binary;base64,([^"]+)"\)', html)
     assert sum(b"set_animation" in base64.b64decode(b) for b in blobs) == 1
     with pytest.raises(VicDrakeError, match="lacks columns"):
-        replay_scan(df.drop(columns=["q_cmd_0_rad"]), scenario,
-                    phantom=load_phantom("synthetic"))
+        replay_scan(
+            df.drop(columns=["q_cmd_0_rad"]),
+            scenario,
+            phantom=load_phantom("synthetic"),
+        )

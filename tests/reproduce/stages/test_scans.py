@@ -2,6 +2,8 @@
 
 import pytest
 
+from vic_drake.errors import VicDrakeError
+
 
 def test_scan_scenarios_cover_the_paper_runs():
     from vic_drake.reproduce import CONTROLLERS, scan_limits, scan_scenario
@@ -11,7 +13,9 @@ def test_scan_scenarios_cover_the_paper_runs():
             s = scan_scenario(c, disturbed=False, phantom_kind="synthetic", quick=quick)
             assert s.controller.reference.controller == c
             assert s.disturbance.is_nominal
-        d = scan_scenario("vs-vf", disturbed=True, phantom_kind="synthetic", quick=quick)
+        d = scan_scenario(
+            "vs-vf", disturbed=True, phantom_kind="synthetic", quick=quick
+        )
         lifts = d.disturbance.lifts
         assert len(lifts) == (2 if quick else 4)
         # Every event ends (phantom back at rest) before the target lifts off.
@@ -21,7 +25,31 @@ def test_scan_scenarios_cover_the_paper_runs():
             assert lift.start_s + lift.rise_s + lift.hold_s + lift.fall_s < scan_end
         # Dropped below rest: contact loss must be possible.
         assert min(lift.height_m for lift in lifts) < 0
-    lim = scan_limits(scan_scenario("vs-vf", disturbed=False, phantom_kind="synthetic",
-                                    quick=True))
+    lim = scan_limits(
+        scan_scenario("vs-vf", disturbed=False, phantom_kind="synthetic", quick=True)
+    )
     assert lim.k_min_z_N_per_m == 100.0 and lim.tank_min_J == 0.4
     assert lim.power_max_W == pytest.approx(0.1) and lim.eps_d_m == 0.008
+
+
+def test_the_paper_scans_are_built_from_the_diagram_files(monkeypatch, tmp_path):
+    """reproduce reads diagrams/*.yaml: a changed file changes the scan."""
+    import importlib
+
+    from vic_drake.paths import DIAGRAMS_DIR
+    from vic_drake.reproduce import scan_scenario
+
+    text = (DIAGRAMS_DIR / "nominal_cf_synthetic.yaml").read_text()
+    assert "    controller: cf\n" in text
+    (tmp_path / "nominal_cf_synthetic.yaml").write_text(
+        text.replace(
+            "    controller: cf\n", "    controller: cf\n    force_ref_N: 5.5\n"
+        )
+    )
+    # The module, not the function of the same name that the package exports.
+    module = importlib.import_module("vic_drake.experiments.paper_scenarios")
+    monkeypatch.setattr(module, "DIAGRAMS_DIR", tmp_path)
+    s = scan_scenario("cf", disturbed=False, phantom_kind="synthetic", quick=True)
+    assert s.controller.reference.force_ref_N == 5.5
+    with pytest.raises(VicDrakeError, match="controller must be one of"):
+        scan_scenario("pid", disturbed=False, phantom_kind="synthetic", quick=True)

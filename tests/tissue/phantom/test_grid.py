@@ -28,10 +28,17 @@ def test_grid_clamps_outside_and_zeroes_gradient_across_edge():
 
 def test_grid_surface_offset_and_nearest_lookup():
     p = plane_phantom(surface_offset_m=0.0025, lookup="nearest")
-    assert p.surface_z(0.0437, 0.0213) == pytest.approx(0.1 + 0.2 * 0.04 - 0.1 * 0.02 + 0.0025)
+    assert p.surface_z(0.0437, 0.0213) == pytest.approx(
+        0.1 + 0.2 * 0.04 - 0.1 * 0.02 + 0.0025
+    )
 
 
 def test_grid_rejects_bad_shapes():
     with pytest.raises(VicDrakeError, match="kappa has shape"):
-        GridPhantom(x_m=[0, 1], y_m=[0, 1], z_m=np.zeros((2, 2)), kappa=np.zeros((3, 2)),
-                    lam=np.zeros((2, 2)))
+        GridPhantom(
+            x_m=[0, 1],
+            y_m=[0, 1],
+            z_m=np.zeros((2, 2)),
+            kappa=np.zeros((3, 2)),
+            lam=np.zeros((2, 2)),
+        )

@@ -19,4 +19,5 @@ def test_measured_map(data_dir):
     # The real controller's tissue surface is map z + 2.5 mm.
     assert p.surface_z(p.x_m[5], p.y_m[7]) == pytest.approx(p.surface_m[5, 7])
     assert p.surface_m[5, 7] - 0.0025 == pytest.approx(
-        np.loadtxt(data_dir / "phantom_map" / "z.txt")[5 * 103 + 7])
+        np.loadtxt(data_dir / "phantom_map" / "z.txt")[5 * 103 + 7]
+    )

@@ -11,8 +11,9 @@ def test_point_lookup_cached_per_phantom_and_mode():
     p = plane_phantom()
     fast = p.point_lookup()
     assert p.point_lookup() is fast
-    assert fast(0.0437, 0.0213) == pytest.approx(tuple(
-        float(v) for v in vars(p.sample(0.0437, 0.0213)).values()))
+    assert fast(0.0437, 0.0213) == pytest.approx(
+        tuple(float(v) for v in vars(p.sample(0.0437, 0.0213)).values())
+    )
     # A copy switched to nearest lookup must not reuse the bilinear lookup.
     q = copy.copy(p)
     q.lookup = "nearest"

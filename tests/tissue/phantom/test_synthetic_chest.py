@@ -23,7 +23,9 @@ def test_synthetic_ribs_stand_out_and_muscle_rib_is_softer():
     between = float(p.kappa(p.rib_centres_x(y)[1] + 0.02, y))
     assert min(peaks) > 1.5 * between
     muscle = peaks[p.params.muscle_rib_index]
-    assert muscle < 0.8 * min(v for i, v in enumerate(peaks) if i != p.params.muscle_rib_index)
+    assert muscle < 0.8 * min(
+        v for i, v in enumerate(peaks) if i != p.params.muscle_rib_index
+    )
 
 
 def test_synthetic_gradient_matches_finite_difference():
@@ -31,8 +33,12 @@ def test_synthetic_gradient_matches_finite_difference():
     h = 1e-4
     x, y = -0.03, -0.40
     s = p.sample(x, y)
-    assert s.dz_dx == pytest.approx((p.surface_z(x + h, y) - p.surface_z(x - h, y)) / (2 * h), rel=1e-4)
-    assert s.dz_dy == pytest.approx((p.surface_z(x, y + h) - p.surface_z(x, y - h)) / (2 * h), rel=1e-4)
+    assert s.dz_dx == pytest.approx(
+        (p.surface_z(x + h, y) - p.surface_z(x - h, y)) / (2 * h), rel=1e-4
+    )
+    assert s.dz_dy == pytest.approx(
+        (p.surface_z(x, y + h) - p.surface_z(x, y - h)) / (2 * h), rel=1e-4
+    )
 
 
 def test_synthetic_params_validated():

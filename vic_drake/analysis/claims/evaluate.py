@@ -26,7 +26,9 @@ class ClaimInputs:
     decay_real: tuple | None = None
     ribs_sim: dict | None = None
     ribs_real: dict | None = None
-    nominal_sim: dict | None = None  # {"cs": metrics, "cf": ..., "vs-cf": ..., "vs-vf": ...}
+    nominal_sim: dict | None = (
+        None  # {"cs": metrics, "cf": ..., "vs-cf": ..., "vs-vf": ...}
+    )
     nominal_real: dict | None = None
     disturbance_sim: dict | None = None  # {"vs-vf": ..., "cs": ..., "cf": ...}
     disturbance_real: dict | None = None
@@ -42,19 +44,48 @@ def evaluate_claims(inp: ClaimInputs) -> list[Claim]:
         return r.get(f"{cid}.{side}") or r.get(side) or "stage result missing"
 
     return [
-        claim_c1(inp.residuals_sim, inp.residuals_real,
-                 reason_sim=why("C1", "sim"), reason_real=why("C1", "real")),
-        claim_c2(inp.decay_sim, inp.decay_real,
-                 reason_sim=why("C2", "sim"), reason_real=why("C2", "real")),
-        claim_c3(inp.ribs_sim, inp.ribs_real,
-                 reason_sim=why("C3", "sim"), reason_real=why("C3", "real")),
-        claim_c4(inp.nominal_sim, inp.nominal_real,
-                 reason_sim=why("C4", "sim"), reason_real=why("C4", "real")),
-        claim_c5(inp.nominal_sim, inp.nominal_real,
-                 reason_sim=why("C5", "sim"), reason_real=why("C5", "real")),
-        claim_c6((inp.nominal_sim or {}).get("vs-vf"), (inp.nominal_real or {}).get("vs-vf"),
-                 eps_d_m=inp.limits.eps_d_m,
-                 reason_sim=why("C6", "sim"), reason_real=why("C6", "real")),
-        claim_c7(inp.disturbance_sim, inp.disturbance_real, limits=inp.limits,
-                 reason_sim=why("C7", "sim"), reason_real=why("C7", "real")),
+        claim_c1(
+            inp.residuals_sim,
+            inp.residuals_real,
+            reason_sim=why("C1", "sim"),
+            reason_real=why("C1", "real"),
+        ),
+        claim_c2(
+            inp.decay_sim,
+            inp.decay_real,
+            reason_sim=why("C2", "sim"),
+            reason_real=why("C2", "real"),
+        ),
+        claim_c3(
+            inp.ribs_sim,
+            inp.ribs_real,
+            reason_sim=why("C3", "sim"),
+            reason_real=why("C3", "real"),
+        ),
+        claim_c4(
+            inp.nominal_sim,
+            inp.nominal_real,
+            reason_sim=why("C4", "sim"),
+            reason_real=why("C4", "real"),
+        ),
+        claim_c5(
+            inp.nominal_sim,
+            inp.nominal_real,
+            reason_sim=why("C5", "sim"),
+            reason_real=why("C5", "real"),
+        ),
+        claim_c6(
+            (inp.nominal_sim or {}).get("vs-vf"),
+            (inp.nominal_real or {}).get("vs-vf"),
+            eps_d_m=inp.limits.eps_d_m,
+            reason_sim=why("C6", "sim"),
+            reason_real=why("C6", "real"),
+        ),
+        claim_c7(
+            inp.disturbance_sim,
+            inp.disturbance_real,
+            limits=inp.limits,
+            reason_sim=why("C7", "sim"),
+            reason_real=why("C7", "real"),
+        ),
     ]

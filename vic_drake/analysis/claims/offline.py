@@ -44,7 +44,9 @@ class ModelResiduals:
             raise VicDrakeError("ModelResiduals.hunt_crossley needs at least one beta")
         values = [self.kelvin_voigt, *self.hunt_crossley.values()]
         if not all(np.isfinite(v) and v >= 0 for v in values):
-            raise VicDrakeError(f"ModelResiduals: residuals must be finite and >= 0, got {values}")
+            raise VicDrakeError(
+                f"ModelResiduals: residuals must be finite and >= 0, got {values}"
+            )
 
     def as_dict(self) -> dict:
         out = {"kelvin_voigt": self.kelvin_voigt}
@@ -66,8 +68,13 @@ def _c1_side(res: ModelResiduals) -> tuple[dict, bool]:
     return value, bool(ok)
 
 
-def claim_c1(sim: ModelResiduals | None, real: ModelResiduals | None, *,
-             reason_sim: str | None = None, reason_real: str | None = None) -> Claim:
+def claim_c1(
+    sim: ModelResiduals | None,
+    real: ModelResiduals | None,
+    *,
+    reason_sim: str | None = None,
+    reason_real: str | None = None,
+) -> Claim:
     """C1: HC beats KV and beta = 1.35 is the best of the betas tried.
 
     Passes on a side when the best HC residual is below KV's and the best
@@ -75,11 +82,22 @@ def claim_c1(sim: ModelResiduals | None, real: ModelResiduals | None, *,
     """
     sv, sp = _c1_side(sim) if sim is not None else (None, None)
     rv, rp = _c1_side(real) if real is not None else (None, None)
-    detail = "relative RMS residuals; pass: min over beta of HC < KV and argmin beta = 1.35"
-    extra = not_evaluated(reason_sim if sim is None else None,
-                           reason_real if real is None else None)
-    return Claim("C1", STATEMENTS["C1"], paper_table_i(), clean(sv), clean(rv), sp, rp,
-                 "; ".join(p for p in (detail, extra) if p))
+    detail = (
+        "relative RMS residuals; pass: min over beta of HC < KV and argmin beta = 1.35"
+    )
+    extra = not_evaluated(
+        reason_sim if sim is None else None, reason_real if real is None else None
+    )
+    return Claim(
+        "C1",
+        STATEMENTS["C1"],
+        paper_table_i(),
+        clean(sv),
+        clean(rv),
+        sp,
+        rp,
+        "; ".join(p for p in (detail, extra) if p),
+    )
 
 
 def residual_decay(duration_s, residual) -> dict:
@@ -112,7 +130,14 @@ def residual_decay(duration_s, residual) -> dict:
 
     p0 = (max(r[0] - r[-1], 1e-9), span / 3, r[-1])
     try:
-        (a, tau, c), _ = curve_fit(model, t, r, p0=p0, bounds=([0, 1e-6, -np.inf], [np.inf, 1e3 * span, np.inf]), maxfev=20000)
+        (a, tau, c), _ = curve_fit(
+            model,
+            t,
+            r,
+            p0=p0,
+            bounds=([0, 1e-6, -np.inf], [np.inf, 1e3 * span, np.inf]),
+            maxfev=20000,
+        )
         pred = model(t, a, tau, c)
         ss_res = float(np.sum((r - pred) ** 2))
         ss_tot = float(np.sum((r - r.mean()) ** 2))
@@ -140,8 +165,13 @@ def _c2_pass(d: dict) -> bool:
     )
 
 
-def claim_c2(sim: tuple | None, real: tuple | None, *, reason_sim: str | None = None,
-             reason_real: str | None = None) -> Claim:
+def claim_c2(
+    sim: tuple | None,
+    real: tuple | None,
+    *,
+    reason_sim: str | None = None,
+    reason_real: str | None = None,
+) -> Claim:
     """C2: residual vs palpation time falls about exponentially.
 
     Args:
@@ -151,6 +181,7 @@ def claim_c2(sim: tuple | None, real: tuple | None, *, reason_sim: str | None = 
     Passes on a side when Spearman rho <= -0.8 and the exponential model has
     R^2 >= 0.9 with a positive amplitude.
     """
+
     def side(curves):
         if curves is None:
             return None, None
@@ -164,40 +195,69 @@ def claim_c2(sim: tuple | None, real: tuple | None, *, reason_sim: str | None = 
 
     sv, sp = side(sim)
     rv, rp = side(real)
-    detail = (f"fit r(T)=c+a exp(-T/tau); pass: spearman <= {C2_MAX_SPEARMAN}, "
-              f"R^2 >= {C2_MIN_R2}, a > 0, r(T_max)/r(T_min) <= {C2_MAX_RATIO} (every log)")
-    extra = not_evaluated(reason_sim if sim is None else None,
-                           reason_real if real is None else None)
-    return Claim("C2", STATEMENTS["C2"],
-                 "residual decreases exponentially with palpation time; 5 s chosen",
-                 clean(sv), clean(rv), sp, rp,
-                 "; ".join(p for p in (detail, extra) if p))
+    detail = (
+        f"fit r(T)=c+a exp(-T/tau); pass: spearman <= {C2_MAX_SPEARMAN}, "
+        f"R^2 >= {C2_MIN_R2}, a > 0, r(T_max)/r(T_min) <= {C2_MAX_RATIO} (every log)"
+    )
+    extra = not_evaluated(
+        reason_sim if sim is None else None, reason_real if real is None else None
+    )
+    return Claim(
+        "C2",
+        STATEMENTS["C2"],
+        "residual decreases exponentially with palpation time; 5 s chosen",
+        clean(sv),
+        clean(rv),
+        sp,
+        rp,
+        "; ".join(p for p in (detail, extra) if p),
+    )
 
 
 def _c3_pass(d: dict) -> bool:
-    spacing_ok = d.get("min_spacing_m") is None or d["min_spacing_m"] >= C3_MIN_RIB_SPACING_M
+    spacing_ok = (
+        d.get("min_spacing_m") is None or d["min_spacing_m"] >= C3_MIN_RIB_SPACING_M
+    )
     return bool(d["n_strong"] >= C3_MIN_STRONG_RIBS and d["n_weak"] >= 1 and spacing_ok)
 
 
-def claim_c3(sim: dict | None, real: dict | None, *, reason_sim: str | None = None,
-             reason_real: str | None = None) -> Claim:
+def claim_c3(
+    sim: dict | None,
+    real: dict | None,
+    *,
+    reason_sim: str | None = None,
+    reason_real: str | None = None,
+) -> Claim:
     """C3: >= 3 ribs stand out in the kappa map and at least one is weaker.
 
     Args:
         sim, real: outputs of :func:`rib_prominences` (estimated map in
             simulation; the paper's measured map), or None.
     """
-    detail = (f"ribs = peaks of the median-over-y kappa profile with prominence >= "
-              f"{RIB_MIN_PROMINENCE:.0%} of median kappa; strong = prominence >= "
-              f"{RIB_STRONG_PROMINENCE:.0%} of median kappa; weak = prominence <= "
-              f"{RIB_WEAK_FRACTION:.0%} of the strong ribs' median; pass: >= "
-              f"{C3_MIN_STRONG_RIBS} strong ribs, >= 1 weak rib, ribs >= "
-              f"{C3_MIN_RIB_SPACING_M * 100:g} cm apart")
-    extra = not_evaluated(reason_sim if sim is None else None,
-                           reason_real if real is None else None)
-    return Claim("C3", STATEMENTS["C3"],
-                 {"n_ribs": 4, "n_strong": 3, "n_weak": 1, "text": "4 stiff lines, 3 evident, 1 less "
-                  "(the rib covered by the pectoral muscle)"},
-                 clean(sim), clean(real),
-                 _c3_pass(sim) if sim else None, _c3_pass(real) if real else None,
-                 "; ".join(p for p in (detail, extra) if p))
+    detail = (
+        f"ribs = peaks of the median-over-y kappa profile with prominence >= "
+        f"{RIB_MIN_PROMINENCE:.0%} of median kappa; strong = prominence >= "
+        f"{RIB_STRONG_PROMINENCE:.0%} of median kappa; weak = prominence <= "
+        f"{RIB_WEAK_FRACTION:.0%} of the strong ribs' median; pass: >= "
+        f"{C3_MIN_STRONG_RIBS} strong ribs, >= 1 weak rib, ribs >= "
+        f"{C3_MIN_RIB_SPACING_M * 100:g} cm apart"
+    )
+    extra = not_evaluated(
+        reason_sim if sim is None else None, reason_real if real is None else None
+    )
+    return Claim(
+        "C3",
+        STATEMENTS["C3"],
+        {
+            "n_ribs": 4,
+            "n_strong": 3,
+            "n_weak": 1,
+            "text": "4 stiff lines, 3 evident, 1 less "
+            "(the rib covered by the pectoral muscle)",
+        },
+        clean(sim),
+        clean(real),
+        _c3_pass(sim) if sim else None,
+        _c3_pass(real) if real else None,
+        "; ".join(p for p in (detail, extra) if p),
+    )

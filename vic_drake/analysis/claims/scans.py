@@ -27,14 +27,20 @@ from vic_drake.paper import CONTACT_THRESHOLD_N
 #: The paper's reference settings (the real controller's: the defaults).
 _PAPER_REFERENCE = ReferenceParams(controller="vs-vf")
 
+
 def _need(d: Mapping | None, *keys) -> bool:
     return d is not None and all(d.get(k) is not None for k in keys)
 
 
 def _c4_side(vscf: Mapping | None, cf: Mapping | None):
-    if not (_need(vscf, "force_rmse_N", "lifted_off") and _need(cf, "force_rmse_N", "lifted_off")):
+    if not (
+        _need(vscf, "force_rmse_N", "lifted_off")
+        and _need(cf, "force_rmse_N", "lifted_off")
+    ):
         return None, None
-    ratio = vscf["force_rmse_N"] / cf["force_rmse_N"] if cf["force_rmse_N"] > 0 else np.inf
+    ratio = (
+        vscf["force_rmse_N"] / cf["force_rmse_N"] if cf["force_rmse_N"] > 0 else np.inf
+    )
     value = {
         "force_rmse_vs_cf_N": vscf["force_rmse_N"],
         "force_rmse_cf_N": cf["force_rmse_N"],
@@ -46,8 +52,13 @@ def _c4_side(vscf: Mapping | None, cf: Mapping | None):
     return value, bool(ok)
 
 
-def claim_c4(sim: Mapping[str, Mapping] | None, real: Mapping[str, Mapping] | None, *,
-             reason_sim: str | None = None, reason_real: str | None = None) -> Claim:
+def claim_c4(
+    sim: Mapping[str, Mapping] | None,
+    real: Mapping[str, Mapping] | None,
+    *,
+    reason_sim: str | None = None,
+    reason_real: str | None = None,
+) -> Claim:
     """C4: VS-CF's force RMSE <= 1.2 x CF's; VS-CF lifts off at the end, CF not.
 
     Args:
@@ -55,27 +66,49 @@ def claim_c4(sim: Mapping[str, Mapping] | None, real: Mapping[str, Mapping] | No
     """
     sv, sp = _c4_side(*(sim.get(k) for k in ("vs-cf", "cf"))) if sim else (None, None)
     rv, rp = _c4_side(*(real.get(k) for k in ("vs-cf", "cf"))) if real else (None, None)
-    detail = (f"RMSE of pressing force vs reference over the scan window; pass: ratio <= "
-              f"{C4_MAX_RMSE_RATIO}, VS-CF final force < {CONTACT_THRESHOLD_N} N, CF's not")
-    extra = not_evaluated(reason_sim if sv is None else None,
-                           reason_real if rv is None else None)
-    return Claim("C4", STATEMENTS["C4"],
-                 "VS-CF tracks the reference force as well as force control; only "
-                 "VS-CF can lift off the surface", clean(sv), clean(rv), sp, rp,
-                 "; ".join(p for p in (detail, extra) if p))
+    detail = (
+        f"RMSE of pressing force vs reference over the scan window; pass: ratio <= "
+        f"{C4_MAX_RMSE_RATIO}, VS-CF final force < {CONTACT_THRESHOLD_N} N, CF's not"
+    )
+    extra = not_evaluated(
+        reason_sim if sv is None else None, reason_real if rv is None else None
+    )
+    return Claim(
+        "C4",
+        STATEMENTS["C4"],
+        "VS-CF tracks the reference force as well as force control; only "
+        "VS-CF can lift off the surface",
+        clean(sv),
+        clean(rv),
+        sp,
+        rp,
+        "; ".join(p for p in (detail, extra) if p),
+    )
 
 
 def _c5_side(cs: Mapping | None, vscf: Mapping | None):
     if not (_need(cs, "force_range_N") and _need(vscf, "force_range_N")):
         return None, None
-    ratio = cs["force_range_N"] / vscf["force_range_N"] if vscf["force_range_N"] > 0 else np.inf
-    value = {"force_range_cs_N": cs["force_range_N"],
-             "force_range_vs_cf_N": vscf["force_range_N"], "range_ratio": ratio}
+    ratio = (
+        cs["force_range_N"] / vscf["force_range_N"]
+        if vscf["force_range_N"] > 0
+        else np.inf
+    )
+    value = {
+        "force_range_cs_N": cs["force_range_N"],
+        "force_range_vs_cf_N": vscf["force_range_N"],
+        "range_ratio": ratio,
+    }
     return value, bool(ratio >= C5_MIN_RANGE_RATIO)
 
 
-def claim_c5(sim: Mapping[str, Mapping] | None, real: Mapping[str, Mapping] | None, *,
-             reason_sim: str | None = None, reason_real: str | None = None) -> Claim:
+def claim_c5(
+    sim: Mapping[str, Mapping] | None,
+    real: Mapping[str, Mapping] | None,
+    *,
+    reason_sim: str | None = None,
+    reason_real: str | None = None,
+) -> Claim:
     """C5: CS's force range over the scan >= 2 x VS-CF's.
 
     Args:
@@ -83,34 +116,58 @@ def claim_c5(sim: Mapping[str, Mapping] | None, real: Mapping[str, Mapping] | No
     """
     sv, sp = _c5_side(*(sim.get(k) for k in ("cs", "vs-cf"))) if sim else (None, None)
     rv, rp = _c5_side(*(real.get(k) for k in ("cs", "vs-cf"))) if real else (None, None)
-    detail = ("force range = 98th - 2nd percentile of the pressing force over the scan "
-              f"window; pass: ratio >= {C5_MIN_RANGE_RATIO}")
-    extra = not_evaluated(reason_sim if sv is None else None,
-                           reason_real if rv is None else None)
-    return Claim("C5", STATEMENTS["C5"],
-                 "CS force strongly depends on the body's shape", clean(sv), clean(rv),
-                 sp, rp, "; ".join(p for p in (detail, extra) if p))
+    detail = (
+        "force range = 98th - 2nd percentile of the pressing force over the scan "
+        f"window; pass: ratio >= {C5_MIN_RANGE_RATIO}"
+    )
+    extra = not_evaluated(
+        reason_sim if sv is None else None, reason_real if rv is None else None
+    )
+    return Claim(
+        "C5",
+        STATEMENTS["C5"],
+        "CS force strongly depends on the body's shape",
+        clean(sv),
+        clean(rv),
+        sp,
+        rp,
+        "; ".join(p for p in (detail, extra) if p),
+    )
 
 
 def _c6_side(vsvf: Mapping | None):
-    if not _need(vsvf, "penetration_error_off_ribs_median_m", "force_on_ribs_p99_N",
-                 "force_cap_N"):
+    if not _need(
+        vsvf,
+        "penetration_error_off_ribs_median_m",
+        "force_on_ribs_p99_N",
+        "force_cap_N",
+    ):
         return None, None
     value = {
         "penetration_off_ribs_median_m": vsvf.get("penetration_off_ribs_median_m"),
-        "penetration_error_off_ribs_median_m": vsvf["penetration_error_off_ribs_median_m"],
+        "penetration_error_off_ribs_median_m": vsvf[
+            "penetration_error_off_ribs_median_m"
+        ],
         "force_on_ribs_p99_N": vsvf["force_on_ribs_p99_N"],
         "force_cap_N": vsvf["force_cap_N"],
         "n_on_ribs": vsvf.get("n_on_ribs"),
         "n_off_ribs": vsvf.get("n_off_ribs"),
     }
-    ok = (vsvf["penetration_error_off_ribs_median_m"] <= C6_MAX_PEN_ERROR_M
-          and vsvf["force_on_ribs_p99_N"] <= (1 + C6_FORCE_CAP_TOL) * vsvf["force_cap_N"])
+    ok = (
+        vsvf["penetration_error_off_ribs_median_m"] <= C6_MAX_PEN_ERROR_M
+        and vsvf["force_on_ribs_p99_N"] <= (1 + C6_FORCE_CAP_TOL) * vsvf["force_cap_N"]
+    )
     return value, bool(ok)
 
 
-def claim_c6(sim: Mapping | None, real: Mapping | None, *, eps_d_m: float | None = None,
-             reason_sim: str | None = None, reason_real: str | None = None) -> Claim:
+def claim_c6(
+    sim: Mapping | None,
+    real: Mapping | None,
+    *,
+    eps_d_m: float | None = None,
+    reason_sim: str | None = None,
+    reason_real: str | None = None,
+) -> Claim:
     """C6: VS-VF: median |eps - eps_d| off ribs <= 3 mm; force over ribs capped.
 
     Args:
@@ -123,17 +180,29 @@ def claim_c6(sim: Mapping | None, real: Mapping | None, *, eps_d_m: float | None
     eps_d_m = _PAPER_REFERENCE.eps_d_m if eps_d_m is None else eps_d_m
     sv, sp = _c6_side(sim)
     rv, rp = _c6_side(real)
-    detail = (f"eps_d = {eps_d_m * 1e3:g} mm; pass: median |eps - eps_d| off ribs <= "
-              f"{C6_MAX_PEN_ERROR_M * 1e3:g} mm and p99 force on ribs <= "
-              f"{1 + C6_FORCE_CAP_TOL:g} x |F_min|")
-    extra = not_evaluated(reason_sim if sv is None else None,
-                           reason_real if rv is None else None)
-    return Claim("C6", STATEMENTS["C6"],
-                 {"eps_d_m": _PAPER_REFERENCE.eps_d_m,
-                  "F_min_N": _PAPER_REFERENCE.force_min_z_N,
-                  "text": "constant penetration tracked; the minimum force avoids pushing "
-                  "too hard on the ribs"},
-                 clean(sv), clean(rv), sp, rp, "; ".join(p for p in (detail, extra) if p))
+    detail = (
+        f"eps_d = {eps_d_m * 1e3:g} mm; pass: median |eps - eps_d| off ribs <= "
+        f"{C6_MAX_PEN_ERROR_M * 1e3:g} mm and p99 force on ribs <= "
+        f"{1 + C6_FORCE_CAP_TOL:g} x |F_min|"
+    )
+    extra = not_evaluated(
+        reason_sim if sv is None else None, reason_real if rv is None else None
+    )
+    return Claim(
+        "C6",
+        STATEMENTS["C6"],
+        {
+            "eps_d_m": _PAPER_REFERENCE.eps_d_m,
+            "F_min_N": _PAPER_REFERENCE.force_min_z_N,
+            "text": "constant penetration tracked; the minimum force avoids pushing "
+            "too hard on the ribs",
+        },
+        clean(sv),
+        clean(rv),
+        sp,
+        rp,
+        "; ".join(p for p in (detail, extra) if p),
+    )
 
 
 def _c7_side(runs: Mapping[str, Mapping], limits: ScanLimits):
@@ -166,9 +235,14 @@ def _c7_side(runs: Mapping[str, Mapping], limits: ScanLimits):
     return value, bool(all(checks.values()))
 
 
-def claim_c7(sim: Mapping[str, Mapping] | None, real: Mapping[str, Mapping] | None, *,
-             limits: ScanLimits | None = None, reason_sim: str | None = None,
-             reason_real: str | None = None) -> Claim:
+def claim_c7(
+    sim: Mapping[str, Mapping] | None,
+    real: Mapping[str, Mapping] | None,
+    *,
+    limits: ScanLimits | None = None,
+    reason_sim: str | None = None,
+    reason_real: str | None = None,
+) -> Claim:
     """C7: disturbance runs: K -> K_min when contact is lost, power valve holds,
     T >= T_min, and VS-VF's peak force is below CS's and CF's.
 
@@ -181,16 +255,26 @@ def claim_c7(sim: Mapping[str, Mapping] | None, real: Mapping[str, Mapping] | No
     limits = ScanLimits() if limits is None else limits
     sv, sp = _c7_side(sim, limits) if sim else (None, None)
     rv, rp = _c7_side(real, limits) if real else (None, None)
-    detail = (f"K at min: K_z <= K_min + {C7_K_MIN_TOL_N_PER_M:g} N/m for >= "
-              f"{C7_MIN_FRACTION_AT_K_MIN:.0%} of the loss time after {C7_LOSS_SETTLE_S:g} s; "
-              f"valve: tank power >= -{1 + C7_POWER_TOL:g} P_max (P_max = "
-              f"{limits.power_max_W:g} W); T >= T_min = {limits.tank_min_J:g} J")
+    detail = (
+        f"K at min: K_z <= K_min + {C7_K_MIN_TOL_N_PER_M:g} N/m for >= "
+        f"{C7_MIN_FRACTION_AT_K_MIN:.0%} of the loss time after {C7_LOSS_SETTLE_S:g} s; "
+        f"valve: tank power >= -{1 + C7_POWER_TOL:g} P_max (P_max = "
+        f"{limits.power_max_W:g} W); T >= T_min = {limits.tank_min_J:g} J"
+    )
     if rv is None and real:
         peaks = {k: v.get("peak_force_N") for k, v in real.items() if v}
         detail += f"; real peak forces without a VS-VF disturbance log: {clean(peaks)}"
-    extra = not_evaluated(reason_sim if sv is None else None,
-                           reason_real if rv is None else None)
-    return Claim("C7", STATEMENTS["C7"],
-                 "stiffness decreases to its minimum until re-contact; at re-contact the "
-                 "valves limit its growth; the tank is not emptied",
-                 clean(sv), clean(rv), sp, rp, "; ".join(p for p in (detail, extra) if p))
+    extra = not_evaluated(
+        reason_sim if sv is None else None, reason_real if rv is None else None
+    )
+    return Claim(
+        "C7",
+        STATEMENTS["C7"],
+        "stiffness decreases to its minimum until re-contact; at re-contact the "
+        "valves limit its growth; the tank is not emptied",
+        clean(sv),
+        clean(rv),
+        sp,
+        rp,
+        "; ".join(p for p in (detail, extra) if p),
+    )

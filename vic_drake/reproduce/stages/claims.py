@@ -11,10 +11,18 @@ from vic_drake.reproduce.context import RunContext
 from vic_drake.reproduce.report import ReportTable
 
 #: Metrics of vic_drake.analysis.claims.scan_metrics shown in the scan tables.
-_TABLE_KEYS = ("force_rmse_N", "force_range_N", "peak_force_N", "lifted_off",
-               "penetration_error_off_ribs_median_m", "force_on_ribs_p99_N",
-               "n_contact_losses", "fraction_at_k_min_during_loss", "tank_min_J",
-               "tank_power_min_W")
+_TABLE_KEYS = (
+    "force_rmse_N",
+    "force_range_N",
+    "peak_force_N",
+    "lifted_off",
+    "penetration_error_off_ribs_median_m",
+    "force_on_ribs_p99_N",
+    "n_contact_losses",
+    "fraction_at_k_min_during_loss",
+    "tank_min_J",
+    "tank_power_min_W",
+)
 
 
 def gather_claim_inputs(ctx: RunContext) -> claims_mod.ClaimInputs:
@@ -83,5 +91,11 @@ def _metrics_table(ctx: RunContext, title: str, metrics: dict) -> None:
         for ctrl, m in by_ctrl.items():
             rows.append([cond, ctrl, *(m.get(k) for k in _TABLE_KEYS)])
     if rows:
-        ctx.tables.append(ReportTable(title, ["condition", "controller", *_TABLE_KEYS], rows,
-                                      "See vic_drake.analysis.claims.scan_metrics for definitions."))
+        ctx.tables.append(
+            ReportTable(
+                title,
+                ["condition", "controller", *_TABLE_KEYS],
+                rows,
+                "See vic_drake.analysis.claims.scan_metrics for definitions.",
+            )
+        )

@@ -12,8 +12,16 @@ from vic_drake.reproduce.report import ReportTable
 from vic_drake.reproduce.stages.real_scans import REAL_SCAN_LOGS
 
 #: Keys of vic_drake.experiments.compare_real shown in the report.
-COMPARE_REAL_KEYS = ("controller", "duration_s", "force_rmse_N", "force_peak_err_N",
-                     "z_rmse_mm", "kz_corr", "tank_min_J", "rtf")
+COMPARE_REAL_KEYS = (
+    "controller",
+    "duration_s",
+    "force_rmse_N",
+    "force_peak_err_N",
+    "z_rmse_mm",
+    "kz_corr",
+    "tank_min_J",
+    "rtf",
+)
 
 
 def _compare_real_job(args):
@@ -38,30 +46,44 @@ def stage_compare_real(ctx: RunContext) -> dict:
     names = sorted(set(REAL_SCAN_LOGS.values()))
     workers = max(1, min(len(names), os.cpu_count() or 1))
     out = {}
-    with ProcessPoolExecutor(max_workers=workers,
-                             mp_context=multiprocessing.get_context("spawn")) as pool:
-        jobs = {name: pool.submit(_compare_real_job,
-                                  (ctx.data_dir / "experiments" / name, ctx.data_dir))
-                for name in names}
+    with ProcessPoolExecutor(
+        max_workers=workers, mp_context=multiprocessing.get_context("spawn")
+    ) as pool:
+        jobs = {
+            name: pool.submit(
+                _compare_real_job, (ctx.data_dir / "experiments" / name, ctx.data_dir)
+            )
+            for name in names
+        }
         for name, fut in jobs.items():
             out[name] = fut.result()
-            ctx.progress(f"  {name}: force RMSE {out[name][0]['force_rmse_N']:.2f} N, "
-                         f"z RMSE {out[name][0]['z_rmse_mm']:.1f} mm")
-    ctx.tables.append(ReportTable(
-        "Real experiments re-run in simulation (measured map)",
-        ["log", *COMPARE_REAL_KEYS],
-        [[name, *(res[0].get(k) for k in COMPARE_REAL_KEYS)] for name, res in out.items()],
-        "vic_drake.experiments.compare_real: each real scan's target, controller settings "
-        "and (for _dist logs) estimated phantom lift, simulated and compared with the log "
-        "after time alignment. kz_corr: correlation of simulated and logged K_z."))
+            ctx.progress(
+                f"  {name}: force RMSE {out[name][0]['force_rmse_N']:.2f} N, "
+                f"z RMSE {out[name][0]['z_rmse_mm']:.1f} mm"
+            )
+    ctx.tables.append(
+        ReportTable(
+            "Real experiments re-run in simulation (measured map)",
+            ["log", *COMPARE_REAL_KEYS],
+            [
+                [name, *(res[0].get(k) for k in COMPARE_REAL_KEYS)]
+                for name, res in out.items()
+            ],
+            "vic_drake.experiments.compare_real: each real scan's target, controller settings "
+            "and (for _dist logs) estimated phantom lift, simulated and compared with the log "
+            "after time alignment. kz_corr: correlation of simulated and logged K_z.",
+        )
+    )
     # Function-local: matplotlib (heavy).
     from vic_drake.reproduce.plots.scans import plot_comparison
 
     for name in ("test_nardi_matForce_lowR", "test_compliance_control400_dist"):
         if name in out:
             _, sim_df, real_df = out[name]
-            ctx.add_figure(f"Real vs simulated: {name}",
-                           "The real log and its simulation on the measured map.",
-                           plot_comparison(sim_df, real_df, title=name),
-                           f"compare_real_{name}.png")
+            ctx.add_figure(
+                f"Real vs simulated: {name}",
+                "The real log and its simulation on the measured map.",
+                plot_comparison(sim_df, real_df, title=name),
+                f"compare_real_{name}.png",
+            )
     return {name: res[0] for name, res in out.items()}

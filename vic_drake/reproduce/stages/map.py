@@ -44,12 +44,24 @@ def stage_map(ctx: RunContext) -> dict:
     res = 0.001 if ctx.options.quick else 1e-4
     # The same pipeline as `vic-drake map`; the comparison with the phantom
     # is the stage's own (below, on a 1 mm subgrid).
-    mapped = run_map_pipeline(phantom, params, resolution_m=res, compare=False,
-                              progress=lambda m: ctx.progress(f"  {m}"))
+    mapped = run_map_pipeline(
+        phantom,
+        params,
+        resolution_m=res,
+        compare=False,
+        progress=lambda m: ctx.progress(f"  {m}"),
+    )
     campaign, tmap = mapped.campaign, mapped.tissue_map
-    _write_log(ctx, "campaign_points", campaign.points.drop(columns=["message"]),
-               {"campaign_params": params, "phantom": ctx.phantom_kind,
-                "lag_s": campaign.lag_s})
+    _write_log(
+        ctx,
+        "campaign_points",
+        campaign.points.drop(columns=["message"]),
+        {
+            "campaign_params": params,
+            "phantom": ctx.phantom_kind,
+            "lag_s": campaign.lag_s,
+        },
+    )
     pts = campaign.ok
     out["ribs_sim"] = rib_prominences(tmap.x_m, tmap.y_m, tmap.kappa)
     out["campaign"] = campaign
@@ -65,20 +77,32 @@ def stage_map(ctx: RunContext) -> dict:
         f"GP maps every {res * 1e3:g} mm from {len(pts)} palpations simulated on a 1 cm grid "
         f"of the {ctx.phantom_kind} phantom over x {region[0]:.3f}..{region[1]:.3f} m, "
         f"y {region[2]:.3f}..{region[3]:.3f} m (dots: palpation points).",
-        plot_stiffness_damping_maps(tmap), "fig4_gp_maps.png")
+        plot_stiffness_damping_maps(tmap),
+        "fig4_gp_maps.png",
+    )
     ctx.add_figure(
         "Fig. 4 (comparison): estimated maps and the paper's measured map",
         "Top: the estimated maps with the detected ribs (red dotted lines); bottom (with "
         "the paper's data): the paper's own GP map. kappa relative RMS error of the "
         f"estimate against the phantom: {out['kappa_rel_rmse']:.1%}.",
-        _plot_maps(tmap, pts, real_map, out["ribs_sim"],
-                   rib_prominences(real_map.x_m, real_map.y_m, real_map.kappa)
-                   if real_map is not None else None),
-        "fig4_maps_vs_paper.png")
+        _plot_maps(
+            tmap,
+            pts,
+            real_map,
+            out["ribs_sim"],
+            rib_prominences(real_map.x_m, real_map.y_m, real_map.kappa)
+            if real_map is not None
+            else None,
+        ),
+        "fig4_maps_vs_paper.png",
+    )
     ctx.add_figure(
         "Fig. 5: surface with elasticity",
         "The GRIDFIT-like surface through the contact points, coloured by the kappa map "
-        "(the paper's Fig. 5).", plot_surface_kappa(tmap), "fig5_surface_kappa.png")
+        "(the paper's Fig. 5).",
+        plot_surface_kappa(tmap),
+        "fig5_surface_kappa.png",
+    )
     return out
 
 
@@ -93,7 +117,9 @@ def _plot_maps(tmap, pts, real_map, ribs_sim, ribs_real):
 
     def show(ax, x, y, grid, title, ribs=None):
         ext = [x[0], x[-1], y[0], y[-1]]
-        im = ax.imshow(grid.T, origin="lower", extent=ext, aspect="equal", cmap="viridis")
+        im = ax.imshow(
+            grid.T, origin="lower", extent=ext, aspect="equal", cmap="viridis"
+        )
         fig.colorbar(im, ax=ax, shrink=0.8)
         ax.set_title(title, fontsize=9)
         ax.set_xlabel("x [m]")
@@ -102,15 +128,37 @@ def _plot_maps(tmap, pts, real_map, ribs_sim, ribs_real):
             ax.axvline(xr, color="r", ls=":", lw=1)
 
     xs, ys = tmap.x_m[::step], tmap.y_m[::step]
-    show(axes[0, 0], xs, ys, tmap.kappa[::step, ::step], "kappa, estimated [N/m^beta]",
-         ribs_sim)
+    show(
+        axes[0, 0],
+        xs,
+        ys,
+        tmap.kappa[::step, ::step],
+        "kappa, estimated [N/m^beta]",
+        ribs_sim,
+    )
     axes[0, 0].plot(pts["x_m"], pts["y_m"], "k.", ms=2)
-    show(axes[0, 1], xs, ys, tmap.lam[::step, ::step],
-         "lambda, estimated [N s/m^(beta+1)]")
+    show(
+        axes[0, 1],
+        xs,
+        ys,
+        tmap.lam[::step, ::step],
+        "lambda, estimated [N s/m^(beta+1)]",
+    )
     if real_map is not None:
-        show(axes[1, 0], real_map.x_m, real_map.y_m, real_map.kappa,
-             "kappa, the paper's measured map", ribs_real)
-        show(axes[1, 1], real_map.x_m, real_map.y_m, real_map.lam,
-             "lambda, the paper's measured map")
+        show(
+            axes[1, 0],
+            real_map.x_m,
+            real_map.y_m,
+            real_map.kappa,
+            "kappa, the paper's measured map",
+            ribs_real,
+        )
+        show(
+            axes[1, 1],
+            real_map.x_m,
+            real_map.y_m,
+            real_map.lam,
+            "lambda, the paper's measured map",
+        )
     fig.tight_layout()
     return fig

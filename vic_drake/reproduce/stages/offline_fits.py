@@ -40,36 +40,74 @@ def offline_fits(ctx: RunContext, logs: dict, label: str) -> dict:
         comparisons[name] = compare_models(data, TABLE_I_BETAS, lag_s=lag)
         curves[name] = residual_vs_palpation_time(shift(data, comparisons[name].lag_s))
     kv = float(np.mean([c.kelvin_voigt.relative for c in comparisons.values()]))
-    hc = {b: float(np.mean([c.hunt_crossley[b].relative for c in comparisons.values()]))
-          for b in TABLE_I_BETAS}
+    hc = {
+        b: float(np.mean([c.hunt_crossley[b].relative for c in comparisons.values()]))
+        for b in TABLE_I_BETAS
+    }
     residuals = claims_mod.ModelResiduals(kv, hc)
     paper = paper_table_i()
     rows = []
     for name, c in comparisons.items():
-        rows.append([name, c.lag_s * 1e3, c.kelvin_voigt.relative,
-                     *(c.hunt_crossley[b].relative for b in TABLE_I_BETAS),
-                     c.best_beta])
+        rows.append(
+            [
+                name,
+                c.lag_s * 1e3,
+                c.kelvin_voigt.relative,
+                *(c.hunt_crossley[b].relative for b in TABLE_I_BETAS),
+                c.best_beta,
+            ]
+        )
     rows.append(["mean", None, kv, *(hc[b] for b in TABLE_I_BETAS), None])
-    rows.append(["paper", None, paper["kelvin_voigt"],
-                 *(paper[f"hc_{b:g}"] for b in TABLE_I_BETAS), BEST_BETA])
-    ctx.tables.append(ReportTable(
-        f"Table I ({label}): relative residual per model",
-        ["log", "lag [ms]", "Kelvin-Voigt", *(f"HC beta={b:g}" for b in TABLE_I_BETAS),
-         "best beta (sweep)"], rows,
-        "Relative residual = RMS least-squares residual / RMS fitted force over the "
-        "in-contact samples (vic_drake.estimation.palpation). The paper does not define "
-        "its number: compare orderings."))
-    ctx.add_figure(f"Table I ({label})", "Relative residual of Kelvin-Voigt and "
-                   "Hunt-Crossley fits; black bars: the paper's values.",
-                   plot_table_i(comparisons), f"table1_{label}.png")
-    ctx.add_figure(f"Beta sweep ({label})", "Hunt-Crossley relative residual against "
-                   "beta; dotted: best beta per log, dashed: the paper's 1.35.",
-                   plot_beta_sweep({n: c.sweep for n, c in comparisons.items()}),
-                   f"beta_sweep_{label}.png")
-    ctx.add_figure(f"Fig. 3 ({label}): residual vs palpation time",
-                   "Relative residual on the whole log of the parameters fitted on the "
-                   "first T seconds, with an exponential fit (paper's Fig. 3).",
-                   plot_residual_vs_time(curves), f"fig3_residual_vs_time_{label}.png")
+    rows.append(
+        [
+            "paper",
+            None,
+            paper["kelvin_voigt"],
+            *(paper[f"hc_{b:g}"] for b in TABLE_I_BETAS),
+            BEST_BETA,
+        ]
+    )
+    ctx.tables.append(
+        ReportTable(
+            f"Table I ({label}): relative residual per model",
+            [
+                "log",
+                "lag [ms]",
+                "Kelvin-Voigt",
+                *(f"HC beta={b:g}" for b in TABLE_I_BETAS),
+                "best beta (sweep)",
+            ],
+            rows,
+            "Relative residual = RMS least-squares residual / RMS fitted force over the "
+            "in-contact samples (vic_drake.estimation.palpation). The paper does not define "
+            "its number: compare orderings.",
+        )
+    )
+    ctx.add_figure(
+        f"Table I ({label})",
+        "Relative residual of Kelvin-Voigt and "
+        "Hunt-Crossley fits; black bars: the paper's values.",
+        plot_table_i(comparisons),
+        f"table1_{label}.png",
+    )
+    ctx.add_figure(
+        f"Beta sweep ({label})",
+        "Hunt-Crossley relative residual against "
+        "beta; dotted: best beta per log, dashed: the paper's 1.35.",
+        plot_beta_sweep({n: c.sweep for n, c in comparisons.items()}),
+        f"beta_sweep_{label}.png",
+    )
+    ctx.add_figure(
+        f"Fig. 3 ({label}): residual vs palpation time",
+        "Relative residual on the whole log of the parameters fitted on the "
+        "first T seconds, with an exponential fit (paper's Fig. 3).",
+        plot_residual_vs_time(curves),
+        f"fig3_residual_vs_time_{label}.png",
+    )
     decay = {n: (c.window_s, c.relative) for n, c in curves.items()}
-    return {"comparisons": comparisons, "curves": curves, "residuals": residuals,
-            "decay": decay}
+    return {
+        "comparisons": comparisons,
+        "curves": curves,
+        "residuals": residuals,
+        "decay": decay,
+    }

@@ -24,16 +24,25 @@ def stage_offline_real(ctx: RunContext) -> dict:
     logs = {}
     for name in REAL_PALPATION_LOGS:
         path = ctx.data_dir / "palpation" / name
-        logs[name] = (PalpationData.from_frame(read_bag(path, expect="palpation")), None)
+        logs[name] = (
+            PalpationData.from_frame(read_bag(path, expect="palpation")),
+            None,
+        )
     out = offline_fits(ctx, logs, "real")
     load = PalpationData.from_frame(
-        read_bag(ctx.data_dir / "loadcycle" / REAL_LOAD_LOG, expect="palpation"))
+        read_bag(ctx.data_dir / "loadcycle" / REAL_LOAD_LOG, expect="palpation")
+    )
     first = REAL_PALPATION_LOGS[0]
     lt = load_test(load, logs[first][0], lag_s=out["comparisons"][first].lag_s)
-    ctx.add_figure("Fig. 2 (real): load test",
-                   f"Load/unload test {REAL_LOAD_LOG} against Kelvin-Voigt and Hunt-Crossley "
-                   f"fitted on {first} (paper's Fig. 2).", plot_load_test(lt),
-                   "fig2_load_test_real.png")
-    out["load_test"] = {"kelvin_voigt_rms_N": lt.kelvin_voigt_rms_N,
-                        "hunt_crossley_rms_N": lt.hunt_crossley_rms_N}
+    ctx.add_figure(
+        "Fig. 2 (real): load test",
+        f"Load/unload test {REAL_LOAD_LOG} against Kelvin-Voigt and Hunt-Crossley "
+        f"fitted on {first} (paper's Fig. 2).",
+        plot_load_test(lt),
+        "fig2_load_test_real.png",
+    )
+    out["load_test"] = {
+        "kelvin_voigt_rms_N": lt.kelvin_voigt_rms_N,
+        "hunt_crossley_rms_N": lt.hunt_crossley_rms_N,
+    }
     return out

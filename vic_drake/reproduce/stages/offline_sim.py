@@ -33,22 +33,47 @@ def stage_offline_sim(ctx: RunContext) -> dict:
     truth = phantom.sample(x, y)
     logs = {}
     for k, f in enumerate(freqs):
-        params = CampaignParams(palpation=PalpationParams(frequency_hz=f,
-                                                          duration_s=duration), seed=k)
+        params = CampaignParams(
+            palpation=PalpationParams(frequency_hz=f, duration_s=duration), seed=k
+        )
         ctx.progress(f"  simulating a {duration:g} s palpation at {f:g} Hz")
-        (rec,) = simulate_palpations(x, y, surface_z=truth.surface_z_m, kappa=truth.kappa,
-                                     lam=truth.lam, beta=phantom.beta, params=params,
-                                     seed=k)
+        (rec,) = simulate_palpations(
+            x,
+            y,
+            surface_z=truth.surface_z_m,
+            kappa=truth.kappa,
+            lam=truth.lam,
+            beta=phantom.beta,
+            params=params,
+            seed=k,
+        )
         lag = params.sensor.lag_samples / params.sensor.rate_hz
         name = f"palpation_sim_{f:g}hz"
-        _write_log(ctx, name, pd.DataFrame({
-            "t_s": rec.t_s, "z_m": rec.z_m, "z_target_m": rec.z_target_m,
-            "force_z_N": rec.force_N,  # Positive = the body pushes the probe up.
-        }), {"campaign_params": params, "point_xy_m": [float(x[0]), float(y[0])],
-             "phantom": ctx.phantom_kind, "seed": k})
-        data = PalpationData(t_s=rec.t_s, z_m=rec.z_m, force_N=rec.force_N,
-                             surface_z_m=float(truth.surface_z_m[0]),
-                             z_target_m=rec.z_target_m)
+        _write_log(
+            ctx,
+            name,
+            pd.DataFrame(
+                {
+                    "t_s": rec.t_s,
+                    "z_m": rec.z_m,
+                    "z_target_m": rec.z_target_m,
+                    "force_z_N": rec.force_N,  # Positive = the body pushes the probe up.
+                }
+            ),
+            {
+                "campaign_params": params,
+                "point_xy_m": [float(x[0]), float(y[0])],
+                "phantom": ctx.phantom_kind,
+                "seed": k,
+            },
+        )
+        data = PalpationData(
+            t_s=rec.t_s,
+            z_m=rec.z_m,
+            force_N=rec.force_N,
+            surface_z_m=float(truth.surface_z_m[0]),
+            z_target_m=rec.z_target_m,
+        )
         logs[f"sim_{f:g}hz"] = (data, lag)
     out = offline_fits(ctx, logs, "sim")
     out["truth"] = {"kappa": float(truth.kappa[0]), "lam": float(truth.lam[0])}

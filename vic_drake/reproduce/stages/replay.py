@@ -38,7 +38,8 @@ def replay_scan(df: pd.DataFrame, scenario, *, phantom, fps: float = REPLAY_FPS)
     meshcat = Meshcat()
     builder = DiagramBuilder()
     station = builder.AddNamedSystem(
-        "station", MakeStation(scenario.station, phantom=phantom, meshcat=meshcat))
+        "station", MakeStation(scenario.station, phantom=phantom, meshcat=meshcat)
+    )
     diagram = builder.Build()
     context = diagram.CreateDefaultContext()
     station_context = station.GetMyMutableContextFromRoot(context)
@@ -47,7 +48,9 @@ def replay_scan(df: pd.DataFrame, scenario, *, phantom, fps: float = REPLAY_FPS)
     idx = np.searchsorted(t, frames).clip(0, len(t) - 1)
     q = df[q_cols].to_numpy()
     lift = df["phantom_lift_m"].to_numpy()
-    meshcat.StartRecording(frames_per_second=fps, set_visualizations_while_recording=False)
+    meshcat.StartRecording(
+        frames_per_second=fps, set_visualizations_while_recording=False
+    )
     for i, tf in zip(idx, frames):
         context.SetTime(float(tf))
         set_station_state(station, station_context, q[i], phantom_lift_m=float(lift[i]))

@@ -38,15 +38,28 @@ REPORT_NOTES = (
 )
 
 
-_PAPER_ORDER = (("Fig. 2", 2.0), ("Table I", 2.5), ("Beta sweep", 2.6), ("Fig. 3", 3.0),
-                ("Fig. 4", 4.0), ("Fig. 5", 5.0), ("Fig. 6", 6.0), ("CS and CF", 6.5),
-                ("Fig. 7", 7.0), ("Real scan logs", 8.0), ("Simulated scans: metrics", 8.1),
-                ("Real experiments", 8.5), ("Real vs simulated", 8.6))
+_PAPER_ORDER = (
+    ("Fig. 2", 2.0),
+    ("Table I", 2.5),
+    ("Beta sweep", 2.6),
+    ("Fig. 3", 3.0),
+    ("Fig. 4", 4.0),
+    ("Fig. 5", 5.0),
+    ("Fig. 6", 6.0),
+    ("CS and CF", 6.5),
+    ("Fig. 7", 7.0),
+    ("Real scan logs", 8.0),
+    ("Simulated scans: metrics", 8.1),
+    ("Real experiments", 8.5),
+    ("Real vs simulated", 8.6),
+)
 
 
 def _paper_order(title: str) -> float:
     """Rank of a figure or table: the paper's order, then the rest."""
-    return next((rank for prefix, rank in _PAPER_ORDER if title.startswith(prefix)), 9.0)
+    return next(
+        (rank for prefix, rank in _PAPER_ORDER if title.startswith(prefix)), 9.0
+    )
 
 
 def _versions() -> dict:
@@ -64,10 +77,14 @@ def _versions() -> dict:
     except ImportError:  # pragma: no cover - drake is a dependency
         drake_version = "not installed"
     return {
-        "vic_drake": vic_drake.__version__, "drake": drake_version,
-        "python": platform.python_version(), "numpy": np.__version__,
-        "scipy": scipy.__version__, "pandas": pd.__version__,
-        "scikit-learn": sklearn.__version__, "matplotlib": matplotlib.__version__,
+        "vic_drake": vic_drake.__version__,
+        "drake": drake_version,
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "scipy": scipy.__version__,
+        "pandas": pd.__version__,
+        "scikit-learn": sklearn.__version__,
+        "matplotlib": matplotlib.__version__,
     }
 
 
@@ -77,8 +94,12 @@ def stage_report(ctx: RunContext) -> dict:
     links = []
     replay = ctx.results.get("replay")
     if replay and replay.get("path"):
-        links.append(("Meshcat replay of one scan (open in a browser)",
-                      os.path.relpath(replay["path"], ctx.out_dir)))
+        links.append(
+            (
+                "Meshcat replay of one scan (open in a browser)",
+                os.path.relpath(replay["path"], ctx.out_dir),
+            )
+        )
     links.append(("claims.json", "claims.json"))
     logs_dir = ctx.out_dir / "logs"
     if logs_dir.is_dir():

@@ -14,6 +14,7 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import replace
 
 from vic_drake.analysis import claims as claims_mod
+from vic_drake.errors import VicDrakeError
 from vic_drake.paper import CONTROLLERS, DISTURBANCE_CONTROLLERS
 from vic_drake.reproduce.context import RunContext
 from vic_drake.reproduce.report import ReportTable
@@ -28,30 +29,32 @@ QUICK_SCAN_M = 0.05
 def scan_scenario(controller: str, *, disturbed: bool, phantom_kind: str, quick: bool):
     """The scenario of one of the paper's scans (nominal or disturbed).
 
-    :func:`vic_drake.experiments.synthetic_scenario` (the scenarios of
-    ``diagrams/``: the real rig's scan and controller settings) on the
+    ``diagrams/nominal_<controller>_synthetic.yaml`` (the real rig's scan and
+    controller settings; :func:`vic_drake.experiments.load_diagram`) on the
     requested phantom, with :func:`vic_drake.experiments.disturbance_lifts`
     as the disturbance.
     Quick mode shortens the approach and the scan (QUICK_* constants) and
     has one disturbance event instead of two.
     """
     # Function-local: the experiments and the scenario pull in pydrake (heavy).
-    from vic_drake.experiments import (
-        disturbance_lifts,
-        scan_start_s,
-        synthetic_scenario,
-    )
+    from vic_drake.experiments import disturbance_lifts, load_diagram, scan_start_s
     from vic_drake.scenario import DisturbanceConfig
 
-    base = synthetic_scenario(controller, disturbed=False)
+    if controller not in CONTROLLERS:
+        raise VicDrakeError(
+            f"controller must be one of {list(CONTROLLERS)}; got {controller!r}"
+        )
+    base = load_diagram(f"nominal_{controller.replace('-', '_')}_synthetic")
     traj = base.trajectory
     if quick:
-        traj = replace(traj, approach_z_m=QUICK_APPROACH_Z_M,
-                       end_x_m=traj.start_x_m - QUICK_SCAN_M)
+        traj = replace(
+            traj, approach_z_m=QUICK_APPROACH_Z_M, end_x_m=traj.start_x_m - QUICK_SCAN_M
+        )
     disturbance = DisturbanceConfig()
     if disturbed:
         disturbance = DisturbanceConfig(
-            lifts=disturbance_lifts(scan_start_s(traj), events=1 if quick else 2))
+            lifts=disturbance_lifts(scan_start_s(traj), events=1 if quick else 2)
+        )
     cond = "disturbance" if disturbed else "nominal"
     return replace(
         base,
@@ -66,13 +69,7 @@ def scan_scenario(controller: str, *, disturbed: bool, phantom_kind: str, quick:
 
 def scan_limits(scenario) -> claims_mod.ScanLimits:
     """K_min, T_min, P_max, eps_d of a scenario's controller."""
-    c = scenario.controller
-    return claims_mod.ScanLimits(
-        k_min_z_N_per_m=float(c.qp.stiffness_min_N_per_m[2]),
-        tank_min_J=float(c.tank.min_energy_J),
-        power_max_W=float(-c.tank.power_limit_W),
-        eps_d_m=float(c.reference.eps_d_m),
-    )
+    return claims_mod.ScanLimits.from_controller(scenario.controller)
 
 
 def _run_scan_job(args):
@@ -94,11 +91,16 @@ def stage_scans(ctx: RunContext) -> dict:
     from vic_drake.experiments import run_scan
     from vic_drake.scenario import save_scenario
 
-    runs = [("nominal", c) for c in CONTROLLERS] + \
-        [("disturbance", c) for c in DISTURBANCE_CONTROLLERS]
+    runs = [("nominal", c) for c in CONTROLLERS] + [
+        ("disturbance", c) for c in DISTURBANCE_CONTROLLERS
+    ]
     scenarios = {
-        key: scan_scenario(key[1], disturbed=key[0] == "disturbance",
-                           phantom_kind=ctx.phantom_kind, quick=ctx.options.quick)
+        key: scan_scenario(
+            key[1],
+            disturbed=key[0] == "disturbance",
+            phantom_kind=ctx.phantom_kind,
+            quick=ctx.options.quick,
+        )
         for key in runs
     }
     logs = ctx.out_dir / "logs"
@@ -106,16 +108,22 @@ def stage_scans(ctx: RunContext) -> dict:
     local_key = ("nominal", "vs-vf")
     workers = max(1, (os.cpu_count() or 1) - 1)
     remote = [k for k in runs if k != local_key]
-    ctx.progress(f"  {len(runs)} scans: {len(remote)} in {workers} worker process(es), "
-                 f"{local_key[1]} {local_key[0]} in this one")
+    ctx.progress(
+        f"  {len(runs)} scans: {len(remote)} in {workers} worker process(es), "
+        f"{local_key[1]} {local_key[0]} in this one"
+    )
     results = {}
-    with ProcessPoolExecutor(max_workers=workers,
-                             mp_context=multiprocessing.get_context("spawn")) as pool:
-        futures = {pool.submit(_run_scan_job, (scenarios[k], ctx.data_dir)): k
-                   for k in remote}
+    with ProcessPoolExecutor(
+        max_workers=workers, mp_context=multiprocessing.get_context("spawn")
+    ) as pool:
+        futures = {
+            pool.submit(_run_scan_job, (scenarios[k], ctx.data_dir)): k for k in remote
+        }
         t0 = time.perf_counter()
         results[local_key] = run_scan(scenarios[local_key], data_dir=ctx.data_dir)
-        _report_scan(ctx, scenarios[local_key], results[local_key], len(results), len(runs))
+        _report_scan(
+            ctx, scenarios[local_key], results[local_key], len(results), len(runs)
+        )
         for fut in as_completed(futures):
             k = futures[fut]
             results[k] = fut.result()
@@ -137,16 +145,28 @@ def stage_scans(ctx: RunContext) -> dict:
         metrics[cond][ctrl] = claims_mod.scan_metrics(df, limits=lim)
         timing.append([scenario.name, result.sim_s, result.wall_s, result.rtf])
     _scan_figures(ctx, frames)
-    ctx.tables.append(ReportTable(
-        "Simulated scans: timing", ["run", "simulated [s]", "wall [s]", "real-time factor"],
-        timing, f"{workers} worker process(es) plus the main process."))
-    return {"frames": frames, "metrics": metrics, "limits": limits, "timing": timing,
-            "scenarios": scenarios}
+    ctx.tables.append(
+        ReportTable(
+            "Simulated scans: timing",
+            ["run", "simulated [s]", "wall [s]", "real-time factor"],
+            timing,
+            f"{workers} worker process(es) plus the main process.",
+        )
+    )
+    return {
+        "frames": frames,
+        "metrics": metrics,
+        "limits": limits,
+        "timing": timing,
+        "scenarios": scenarios,
+    }
 
 
 def _report_scan(ctx, scenario, result, done: int, total: int) -> None:
-    ctx.progress(f"  scan {done}/{total} {scenario.name}: {result.sim_s:.1f} s simulated "
-                 f"in {result.wall_s:.1f} s (real-time factor {result.rtf:.2f})")
+    ctx.progress(
+        f"  scan {done}/{total} {scenario.name}: {result.sim_s:.1f} s simulated "
+        f"in {result.wall_s:.1f} s (real-time factor {result.rtf:.2f})"
+    )
 
 
 def _scan_figures(ctx: RunContext, frames: dict) -> None:
@@ -154,21 +174,35 @@ def _scan_figures(ctx: RunContext, frames: dict) -> None:
     from vic_drake.reproduce.plots.scans import plot_fig6, plot_fig7
 
     real = (ctx.results.get("real_scans") or {}).get("frames", {})
-    nominal = {k: frames["nominal"][k] for k in ("vs-cf", "vs-vf") if k in frames["nominal"]}
+    nominal = {
+        k: frames["nominal"][k] for k in ("vs-cf", "vs-vf") if k in frames["nominal"]
+    }
     if nominal:
-        ctx.add_figure("Fig. 6: VS-CF and VS-VF, nominal",
-                       "Simulated scans (and the real logs where they exist): force with "
-                       "F_ref and F_min, K_z, penetration, tank energy.",
-                       plot_fig6(nominal, real.get("nominal")), "fig6_nominal.png")
+        ctx.add_figure(
+            "Fig. 6: VS-CF and VS-VF, nominal",
+            "Simulated scans (and the real logs where they exist): force with "
+            "F_ref and F_min, K_z, penetration, tank energy.",
+            plot_fig6(nominal, real.get("nominal")),
+            "fig6_nominal.png",
+        )
     base = {k: frames["nominal"][k] for k in ("cs", "cf") if k in frames["nominal"]}
     if base:
-        ctx.add_figure("CS and CF, nominal (not in the paper's Fig. 6)",
-                       "The baselines' nominal scans, same layout as Fig. 6.",
-                       plot_fig6(base, real.get("nominal")), "fig6_baselines.png")
-    dist = {k: frames["disturbance"][k] for k in DISTURBANCE_CONTROLLERS
-            if k in frames["disturbance"]}
+        ctx.add_figure(
+            "CS and CF, nominal (not in the paper's Fig. 6)",
+            "The baselines' nominal scans, same layout as Fig. 6.",
+            plot_fig6(base, real.get("nominal")),
+            "fig6_baselines.png",
+        )
+    dist = {
+        k: frames["disturbance"][k]
+        for k in DISTURBANCE_CONTROLLERS
+        if k in frames["disturbance"]
+    }
     if dist:
-        ctx.add_figure("Fig. 7: VS-VF, CS, CF with the phantom lifted",
-                       "Phantom lifted and dropped during the scan: force, tip height with "
-                       "the moving surface, K_z (real _dist logs of CS and CF overlaid).",
-                       plot_fig7(dist, real.get("disturbance")), "fig7_disturbance.png")
+        ctx.add_figure(
+            "Fig. 7: VS-VF, CS, CF with the phantom lifted",
+            "Phantom lifted and dropped during the scan: force, tip height with "
+            "the moving surface, K_z (real _dist logs of CS and CF overlaid).",
+            plot_fig7(dist, real.get("disturbance")),
+            "fig7_disturbance.png",
+        )
