@@ -1,6 +1,6 @@
 """Timing of the whole map pipeline (prints figures; no asserts).
 
-    /work/venv/bin/python benchmarks/bench_map.py [--data-dir DIR] [--phantom measured]
+    python benchmarks/bench_map.py [--data-dir DIR] [--phantom measured]
         [--resolution-mm 0.1] [--workers 1] [--time-step-ms 1] [--designs]
 
 Runs what ``vic-drake map`` runs on the measured map's region (21 x 11 = 231

@@ -10,15 +10,8 @@ share of the time spent in each vic_drake system.
     python benchmarks/bench_scan.py [--duration 5] [--scenario diagrams/X.yaml] [--top 25]
         [--qp-solver exact|osqp|clarabel] [--time-step-ms 2] [--no-profile]
 
-Measured (VS-VF nominal, 5 s, this 2-core host, interleaved runs; the host
-is shared, figures vary by about 10 %): before, RTF 0.77-0.80 (2.5-2.6 ms
-per tick) with the 1 ms plant step, the OSQP program and the force
-references, sensor force and probe kinematics recomputed for the loggers;
-after, RTF 1.9-2.2 (0.91-1.05 ms per tick) with the 2 ms plant step, the
-closed-form QP solver, the F/T reading, the tick's references and K, D
-published from state, the probe kinematics from the tissue element and the
-servo front end in C++. ``--qp-solver osqp`` costs about 0.25 ms more per
-tick (1.27-1.38 ms).
+Figures measured with it, and the changes they led to: docs/decisions.md,
+"Scan speed".
 """
 
 from __future__ import annotations

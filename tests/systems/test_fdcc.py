@@ -35,7 +35,7 @@ def test_ports_and_one_tick_equals_the_pure_step(q_start):
         ("joint_positions", 6),
         ("target_position", 3),
         ("stiffness", 3),
-        ("measured_force", 3),
+        ("ft_sensor.force_W", 3),
         ("target_force", 3),
     ]:
         assert system.GetInputPort(name).size() == size

@@ -192,7 +192,7 @@ def MakeScanDiagram(scenario: Scenario, *, phantom=None, meshcat=None, data_dir=
     builder.Connect(
         controller.GetOutputPort("stiffness"), fdcc.GetInputPort("stiffness")
     )
-    builder.Connect(force, fdcc.GetInputPort("measured_force"))
+    builder.Connect(force, fdcc.get_measured_force_input_port())
     builder.Connect(
         controller.GetOutputPort("target_force"), fdcc.GetInputPort("target_force")
     )

@@ -26,7 +26,7 @@ class FdccController(LeafSystem):
             orientation target is FdccParams.target_orientation_wxyz, the
             tool pointing straight down).
         stiffness (3): diagonal translational stiffness K, N/m (>= 0).
-        measured_force (3): F/T force in W, N, sensor convention (negative
+        ft_sensor.force_W (3): F/T force in W, N, sensor convention (negative
             z = pressing into the body).
         target_force (3): force target in W, N, same convention (e.g.
             (0, 0, -7) to press with 7 N; zero for pure compliance).
@@ -67,7 +67,7 @@ class FdccController(LeafSystem):
         self._q_port = self.DeclareVectorInputPort("joint_positions", 6)
         self._target_port = self.DeclareVectorInputPort("target_position", 3)
         self._stiffness_port = self.DeclareVectorInputPort("stiffness", 3)
-        self._measured_port = self.DeclareVectorInputPort("measured_force", 3)
+        self._measured_port = self.DeclareVectorInputPort("ft_sensor.force_W", 3)
         self._target_force_port = self.DeclareVectorInputPort("target_force", 3)
         self._q_cmd = self.DeclareDiscreteState(q0)
         self._internal = self.DeclareDiscreteState(12)
