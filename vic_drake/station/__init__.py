@@ -4,6 +4,8 @@
   made of (with Drake's ``MultibodyPlantConfig`` for the plant).
 - :mod:`vic_drake.station.servo` -- the UR3e's joint position servo front end.
 - :mod:`vic_drake.station.ik` -- probe-tip inverse and forward kinematics.
+- :mod:`vic_drake.station.rig` -- :func:`AddRig`, the C++ core (plant, servo,
+  lift, gravity feed-forward).
 - :mod:`vic_drake.station.builder` -- :func:`MakeStation`, the Diagram.
 
 The arm and tool models are :mod:`vic_drake.models.ur3e` (re-exported here).
@@ -26,6 +28,7 @@ from vic_drake.station.ik import (
     solve_tip_ik,
 )
 from vic_drake.station.params import StationParams
+from vic_drake.station.rig import AddRig, Rig
 from vic_drake.station.servo import (
     joint_filter_step,
     joint_servo_rest_state,
@@ -39,7 +42,9 @@ __all__ = [
     "AddTool",
     "AddUr3e",
     "ArmHandles",
+    "AddRig",
     "MakeStation",
+    "Rig",
     "MakeUr3ePlant",
     "StationParams",
     "initial_q_for_tip",
