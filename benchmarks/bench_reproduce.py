@@ -14,6 +14,7 @@ import os
 import tempfile
 import time
 
+from vic_drake.analysis.claims import claim_status
 from vic_drake.reproduce import ReproduceOptions, reproduce
 
 
@@ -40,9 +41,7 @@ def main() -> None:
     )
     print(
         "claims: "
-        + ", ".join(
-            f"{k} {'PASS' if v['pass'] else 'FAIL'}" for k, v in result.claims.items()
-        )
+        + ", ".join(f"{k} {claim_status(v).upper()}" for k, v in result.claims.items())
     )
 
 

@@ -4,7 +4,10 @@ The notebooks are generated, not hand-edited, so that they stay small,
 diff-able and consistent. Each reads the environment variable
 ``VIC_DRAKE_SHORT``: when it is "1" (the test suite sets it) the runs are
 shortened to a few seconds of simulated time; the text and the calls are the
-same. Outputs are not stored: run the notebooks to see them.
+same. Outputs are not stored: run the notebooks to see them (README,
+"Notebooks"). The plot functions of :mod:`vic_drake.reproduce.plots` return
+figures that Jupyter shows as images; a figure drawn inside an ``if`` block
+is shown with ``display(...)``.
 """
 
 from __future__ import annotations
@@ -243,7 +246,7 @@ if DATA is not None:
                                         duration_s=3.0 if SHORT else None,
                                         return_frames=True)
     print({k: out[k] for k in ("controller", "force_rmse_N", "z_rmse_mm", "tank_min_J")})
-    plot_comparison(sim_df, real_df, title="VS-VF: simulated vs real")"""
+    display(plot_comparison(sim_df, real_df, title="VS-VF: simulated vs real"))"""
         ),
     ]
 

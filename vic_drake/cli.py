@@ -11,13 +11,23 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 
 from vic_drake import __version__
 from vic_drake.errors import VicDrakeError
+from vic_drake.paths import check_data_dir
 
 # Modules under vic_drake.commands, each with register(subparsers).
-COMMAND_MODULES = ("offline", "mapping", "control", "scans", "reproduce")
+COMMAND_MODULES = (
+    "offline",
+    "mapping",
+    "control",
+    "scans",
+    "reproduce",
+    "online",
+    "campaign",
+)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -45,12 +55,27 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
+        # --data-dir or $VIC_DRAKE_DATA naming a folder without the data is
+        # one error for every command, before any work.
+        check_data_dir(getattr(args, "data_dir", None))
         return int(args.handler(args) or 0)
     except VicDrakeError as exc:
         print(f"vic-drake: error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("vic-drake: interrupted", file=sys.stderr)
+        if argv is None:
+            # Run as the program: leave now. The run's files are closed, its
+            # worker processes stopped; the interpreter's teardown of pydrake
+            # would add 1-2 s (docs/decisions.md, "Output paths, data folder, Ctrl-C, run marker").
+            # multiprocessing's own exit step first, so its semaphores are
+            # released (else its resource tracker warns about leaks).
+            import multiprocessing.util
+
+            multiprocessing.util._exit_function()
+            sys.stdout.flush()
+            sys.stderr.flush()
+            os._exit(130)
         return 130
 
 

@@ -92,3 +92,22 @@ def test_nominal_replays_match_the_real_logs(data_dir, capsys, log, kz_min):
     assert out["force_rmse_N"] <= NOMINAL_FORCE_RMSE_N
     if kz_min is not None:
         assert out["kz_corr"] >= kz_min
+
+
+def test_scan_command_writes_the_rigs_bag_and_checks_its_path_first(tmp_path, capsys):
+    from vic_drake.experiments import synthetic_scenario
+    from vic_drake.realdata import read_bag
+    from vic_drake.scenario import save_scenario
+
+    path = save_scenario(synthetic_scenario("cs"), tmp_path / "cs.yaml")
+    (tmp_path / "file").write_text("x")
+    # A bad --bag fails before the simulation, with a clear message.
+    assert main(["scan", str(path), "--bag", str(tmp_path / "file")]) == 2
+    assert "--bag" in capsys.readouterr().err
+    bag = tmp_path / "bag"
+    assert (
+        main(["scan", str(path), "--duration", "0.1", "--bag", str(bag), "--json"]) == 0
+    )
+    out = json.loads(capsys.readouterr().out)
+    assert out["bag"] == str(bag)
+    assert read_bag(bag, expect="scan").attrs["topic"] == "/data_control"

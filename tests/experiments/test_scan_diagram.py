@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from vic_drake.experiments.paper_scenarios import synthetic_scenario
+from vic_drake.experiments.rig_log import RIG_GROUPS
 from vic_drake.experiments.scan_diagram import MakeScanDiagram
 from vic_drake.experiments.scan_logs import LOG_GROUPS
 from vic_drake.experiments.scan_run import run_scan
@@ -12,7 +13,9 @@ from vic_drake.experiments.scan_run import run_scan
 def test_scan_diagram_is_wired_and_logs_every_group():
     diagram, loggers = MakeScanDiagram(synthetic_scenario("vs-vf"))
     assert diagram.get_name() == "scan"
-    assert set(loggers) == {name for name, *_ in LOG_GROUPS}
+    assert set(loggers) == {name for name, *_ in LOG_GROUPS} | {
+        name for name, _ in RIG_GROUPS
+    }
     # Closed loop: no input port is left open.
     assert diagram.num_input_ports() == 0
     for name in (

@@ -42,6 +42,16 @@ def _content():
             "pass_real": None,
             "detail": "no data",
         },
+        "C3": {
+            "statement": "ribs",
+            "paper": "4 ribs",
+            "sim": {"n_ribs": 2},
+            "real": None,
+            "pass": False,
+            "pass_sim": False,
+            "pass_real": None,
+            "detail": "",
+        },
     }
     return ReportContent(
         claims=claims,
@@ -56,8 +66,11 @@ def _content():
 def test_report_is_self_contained_and_escapes(tmp_path):
     path = write_report(_content(), tmp_path / "r" / "report.html")
     text = path.read_text()
-    assert "Claims (1 of 2 pass)" in text
-    assert text.count('class="pass"') == 2 and 'class="fail">FAIL' in text
+    assert "Claims (1 of 3 pass, 1 fail, 1 not evaluated)" in text
+    assert text.count('class="pass"') == 2
+    # The claim that was not evaluated says so; only C3 is a FAIL.
+    assert text.count(">FAIL<") == 2  # C3's sim verdict and its overall verdict
+    assert '<td class="ne">not evaluated</td>' in text
     assert "why &lt;b&gt;" in text  # detail escaped
     # No external resources: every img is inline data, no scripts or stylesheets fetched.
     assert not re.search(r'src="(?!data:)', text)
@@ -80,3 +93,65 @@ def test_format_value():
 def test_render_without_claims():
     text = render_report(ReportContent(title="t"))
     assert "<h1>t</h1>" in text and "Claims" not in text
+
+
+def _wide_content():
+    """A report like a run's: the 12-column scan-metrics table, long claims."""
+    content = _content()
+    keys = [
+        "force_rmse_N",
+        "force_range_N",
+        "peak_force_N",
+        "lifted_off",
+        "penetration_error_off_ribs_median_m",
+        "force_on_ribs_p99_N",
+        "n_contact_losses",
+        "fraction_at_k_min_during_loss",
+        "tank_min_J",
+        "tank_power_min_W",
+    ]
+    rows = [
+        ["disturbance", c, *(123.456789 * (i + 1) for i in range(len(keys)))]
+        for c in ("cs", "cf", "vs-cf", "vs-vf")
+    ]
+    content.tables.append(
+        ReportTable(
+            "Simulated scans: metrics", ["condition", "controller", *keys], rows
+        )
+    )
+    content.claims["C1"]["sim"] = {
+        "a_rather_long_metric_name_without_spaces_" * 3: 0.123456,
+        "per_log": {"test_soft_25hz_and_more": 0.5, "x" * 90: 1.0},
+    }
+    return content
+
+
+def test_report_fits_a_1400_px_browser(tmp_path):
+    """In headless Chromium at 1400 px the page does not scroll sideways:
+    every table fits or scrolls inside its own box."""
+    from tests.browser import chromium, dump_dom, screenshot
+
+    chromium()
+    page = tmp_path / "report.html"
+    write_report(_wide_content(), page)
+    probe = tmp_path / "probe.html"
+    probe.write_text(
+        page.read_text().replace(
+            "</body>",
+            "<script>const w=document.documentElement.scrollWidth;"
+            "const bad=[...document.querySelectorAll('table')].filter(t=>{"
+            "const box=t.parentElement;const r=box.getBoundingClientRect();"
+            "return r.right>window.innerWidth+1||(t.scrollWidth>box.clientWidth+1&&"
+            "getComputedStyle(box).overflowX!=='auto');}).length;"
+            "document.body.insertAdjacentHTML('beforeend',"
+            "`<p id=probe>width=${w} inner=${window.innerWidth} bad=${bad}</p>`);"
+            "</script></body>",
+        )
+    )
+    dom = dump_dom(probe, width=1400)
+    found = re.search(r"width=(\d+) inner=(\d+) bad=(\d+)", dom)
+    assert found, dom[-500:]
+    width, inner, bad = map(int, found.groups())
+    assert inner == 1400 and width <= inner and bad == 0, found.group(0)
+    img = screenshot(page, tmp_path / "report.png", width=1400, height=1000)
+    assert img.shape[1] == 1400 and (img.sum(axis=-1) < 200).mean() > 0.001

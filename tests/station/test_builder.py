@@ -39,7 +39,9 @@ SIZES = {
     "phantom.z_offset": 1,
 }
 
-XY = (-0.06, -0.36)
+#: A nearly level point of the synthetic chest (surface slope < 0.04), on soft
+#: tissue: the tests below press straight down and expect no sideways push.
+XY = (-0.045, -0.40)
 
 
 @pytest.fixture(scope="module")
@@ -68,16 +70,17 @@ def test_station_builds_with_the_contract_ports(phantom):
 
 
 def test_static_press_sensor_reads_the_hunt_crossley_force_once(phantom):
+    # 6 mm into the synthetic chest at XY: about 5.5 N.
     station, context, _ = pressing_station(
-        phantom, 0.01, sensor_lag_samples=0, sensor_noise_std_N=(0.0, 0.0, 0.0)
+        phantom, 0.006, sensor_lag_samples=0, sensor_noise_std_N=(0.0, 0.0, 0.0)
     )
     simulator = Simulator(station, context)
     simulator.AdvanceTo(0.3)
     pen = station.GetOutputPort("tissue.penetration").Eval(context)[0]
     f_hc = station.GetOutputPort("tissue.force_W").Eval(context)
     f_ft = station.GetOutputPort("ft_sensor.force_W").Eval(context)
-    # The servo (integral action) holds the pose; the phantom sinks ~4 um.
-    assert 0.0099 < pen < 0.01001
+    # The servo (integral action) holds the pose; the phantom sinks a few um.
+    assert 0.0059 < pen < 0.00601
     assert f_hc[2] > 5.0
     # Tared sensor = minus the tissue force (sensor convention), and nothing
     # else pushes the tool: Drake contact of the indenter is filtered out.

@@ -39,6 +39,7 @@ from vic_drake.systems.signals import (
     REFERENCES_SIZE,
     STATUS_FIELDS,
     TANK_FIELDS,
+    TICK_RECORD_FIELDS,
 )
 from vic_drake.systems.stiffness_qp import StiffnessQpSystem
 from vic_drake.systems.tank import EnergyTankSystem
@@ -105,6 +106,7 @@ def test_reference_system_ports_and_layout(phantom):
         "force_reference": 3,
         "force_min": 3,
         "contact": len(CONTACT_FIELDS),
+        "tick_record": len(TICK_RECORD_FIELDS),
     }
     context = system.CreateDefaultContext()
     system.get_probe_position_input_port().FixValue(context, P_WP)
@@ -129,6 +131,11 @@ def test_reference_system_ports_and_layout(phantom):
     )
     np.testing.assert_array_equal(
         system.get_force_min_output_port().Eval(context), refs[REF_FORCE_MIN]
+    )
+    # The tick's record: what it read and the map's kappa, lambda there.
+    np.testing.assert_array_equal(
+        system.get_tick_record_output_port().Eval(context),
+        [*P_WP, *V_WP, *F_W, KAPPA, LAM],
     )
 
 

@@ -28,6 +28,7 @@ from vic_drake.commands.common import (
     to_json,
 )
 from vic_drake.errors import VicDrakeError
+from vic_drake.paths import check_output_dir
 
 MAX_MAP_POINTS = 20_000_000  # 2001 x 1001 at 0.1 mm over 20 x 10 cm is 2 M.
 MAX_PALPATION_POINTS = 5_000
@@ -133,16 +134,7 @@ def _parse_region(text: str) -> tuple[float, float, float, float]:
 
 
 def _prepare_out(path: str) -> Path:
-    out = Path(path).expanduser()
-    if out.exists() and not out.is_dir():
-        raise VicDrakeError(
-            f"--out {str(out)!r} is a file; give a folder (it is created)"
-        )
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise VicDrakeError(f"--out {str(out)!r} cannot be created: {exc}") from None
-    return out
+    return check_output_dir(path, "--out")
 
 
 def run_map(args) -> int:

@@ -28,7 +28,7 @@ from vic_drake.commands.common import (
     parse_float_list,
 )
 from vic_drake.errors import DataNotFoundError, VicDrakeError
-from vic_drake.paths import resolve_data_dir
+from vic_drake.paths import PLOT_SUFFIXES, check_output_file, resolve_data_dir
 
 _RELATIVE_HELP = (
     "Relative residual = RMS residual / RMS fitted force over the in-contact "
@@ -125,6 +125,8 @@ def _fit_palpation(args: argparse.Namespace) -> int:
     max_lag = _check_nonneg(args.max_lag, "--max-lag")
     lag = None if args.lag is None else _check_nonneg(args.lag, "--lag")
     mass = _check_nonneg(args.indenter_mass, "--indenter-mass")
+    if args.plot:  # Checked before the fits: a bad path fails now.
+        check_output_file(args.plot, "--plot", PLOT_SUFFIXES)
     say = Progress()
     say(f"reading {args.bag_dir}")
     data = _read_palpation(args.bag_dir, "palpation bag")
@@ -202,6 +204,8 @@ def _load_test(args: argparse.Namespace) -> int:
     max_lag = _check_nonneg(args.max_lag, "--max-lag")
     lag = None if args.lag is None else _check_nonneg(args.lag, "--lag")
     mass = _check_nonneg(args.indenter_mass, "--indenter-mass")
+    if args.plot:  # Checked before the fits: a bad path fails now.
+        check_output_file(args.plot, "--plot", PLOT_SUFFIXES)
     say = Progress()
     say(f"reading {args.bag_dir} and {args.fit_from}")
     load = _read_palpation(args.bag_dir, "load-test bag")

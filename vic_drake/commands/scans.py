@@ -2,7 +2,8 @@
 
 - ``scan SCENARIO.yaml``: simulates a scenario file (``diagrams/*.yaml``)
   and prints its scan metrics; ``--out`` stores the log (parquet or csv) and
-  the exact scenario beside it.
+  the exact scenario beside it; ``--bag DIR`` writes the log as a ROS 2 bag
+  in the real rig's layout.
 - ``compare-real BAG_DIR``: builds the scenario of a real scan log on the
   measured map, simulates it, aligns it with the log and prints the
   comparison (see :func:`vic_drake.experiments.compare_real`).
@@ -21,6 +22,7 @@ from vic_drake.commands.common import (
     emit,
 )
 from vic_drake.errors import VicDrakeError
+from vic_drake.paths import PLOT_SUFFIXES, check_output_file
 
 #: The keys compare-real always prints (its contract), in order.
 COMPARE_KEYS = (
@@ -107,17 +109,26 @@ def register(subparsers) -> None:
     s.add_argument(
         "--out", metavar="FILE", default=None, help="save the log (.parquet or .csv)"
     )
+    s.add_argument(
+        "--bag",
+        metavar="DIR",
+        default=None,
+        help="also write the log as a ROS 2 bag folder in the real rig's layout "
+        "(31 columns on /adaptive_stiffness_data for VS-CF/VS-VF, 9 on "
+        "/data_control for CS/CF; vic_drake.experiments.rig_log)",
+    )
     add_data_dir_option(s)
     add_json_option(s)
     s.set_defaults(handler=run_scan_command)
 
 
+#: Suffixes of a saved log (--out) and of a saved figure (--plot).
+LOG_SUFFIXES = (".parquet", ".csv")
+
+
 def _save_log(df, out: str) -> Path:
     """Writes a scan DataFrame as .parquet or .csv; returns the path."""
-    path = Path(out)
-    if path.suffix not in (".csv", ".parquet"):
-        raise VicDrakeError(f"--out must end in .parquet or .csv; got {str(path)!r}")
-    path.parent.mkdir(parents=True, exist_ok=True)
+    path = check_output_file(out, "--out", LOG_SUFFIXES)
     if path.suffix == ".csv":
         df.to_csv(path, index=False)
     else:
@@ -134,6 +145,11 @@ def run_compare_real(args: argparse.Namespace) -> int:
     force = None if args.force is None else _positive(args.force, "--force")
     r = None if args.r_weight is None else _positive(args.r_weight, "--R")
     duration = None if args.duration is None else _positive(args.duration, "--duration")
+    # Output paths are checked before simulating: a bad one fails now.
+    if args.out:
+        check_output_file(args.out, "--out", LOG_SUFFIXES)
+    if args.plot:
+        check_output_file(args.plot, "--plot", PLOT_SUFFIXES)
     progress = Progress(True)
     out, sim, real = compare_real(
         args.bag_dir,
@@ -172,6 +188,15 @@ def run_scan_command(args: argparse.Namespace) -> int:
 
     scenario = load_scenario(args.scenario)
     duration = None if args.duration is None else _positive(args.duration, "--duration")
+    if args.out:  # Checked before simulating, as --bag below.
+        check_output_file(args.out, "--out", LOG_SUFFIXES)
+    if args.bag:
+        # Checked before simulating: a bad path fails now, not after the run.
+        from vic_drake.experiments.rig_log import check_bag_scenario
+        from vic_drake.realdata_write import check_bag_target
+
+        check_bag_target(args.bag, option="--bag")
+        check_bag_scenario(scenario)
     result = run_scan(
         scenario, duration_s=duration, data_dir=args.data_dir, progress=Progress(True)
     )
@@ -195,5 +220,9 @@ def run_scan_command(args: argparse.Namespace) -> int:
         path = _save_log(df, args.out)
         save_scenario(scenario, path.with_suffix(".scenario.yaml"))
         out["log"] = str(path)
+    if args.bag:
+        from vic_drake.experiments.rig_log import write_scan_bag
+
+        out["bag"] = str(write_scan_bag(result, args.bag))
     emit(out, args.json)
     return 0

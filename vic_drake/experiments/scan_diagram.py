@@ -27,7 +27,14 @@ from pydrake.systems.primitives import (
 )
 
 from vic_drake.errors import VicDrakeError
+from vic_drake.experiments.rig_log import add_rig_loggers
 from vic_drake.experiments.scan_logs import LOG_GROUPS
+from vic_drake.experiments.scan_variations import (
+    add_sensor_faults,
+    controller_map,
+    patient_motion_source,
+    patient_phantom_of,
+)
 from vic_drake.scenario import Scenario
 from vic_drake.station import (
     MakeStation,
@@ -43,6 +50,9 @@ from vic_drake.tissue.phantom import GridPhantom, load_phantom
 
 def load_scenario_phantom(scenario: Scenario, *, data_dir=None):
     """The phantom of a scenario (the measured map needs the data folder)."""
+    patient = patient_phantom_of(scenario)
+    if patient is not None:
+        return patient
     return load_phantom(
         scenario.phantom.kind, data_dir=data_dir, lookup=scenario.phantom.lookup
     )
@@ -126,7 +136,8 @@ def MakeScanDiagram(scenario: Scenario, *, phantom=None, meshcat=None, data_dir=
 
     Returns:
         (diagram, loggers): the Diagram named "scan" and a dict
-        {group name: VectorLogSink} of :data:`LOG_GROUPS`.
+        {group name: VectorLogSink} of :data:`LOG_GROUPS` and of
+        :data:`vic_drake.experiments.rig_log.RIG_GROUPS`.
     """
     if not isinstance(scenario, Scenario):
         raise VicDrakeError(
@@ -143,7 +154,11 @@ def MakeScanDiagram(scenario: Scenario, *, phantom=None, meshcat=None, data_dir=
     controller = builder.AddNamedSystem(
         "variable_impedance_controller",
         MakeVariableImpedanceController(
-            scenario.controller, phantom=_controller_phantom(scenario, phantom)
+            scenario.controller,
+            phantom=controller_map(scenario, _controller_phantom(scenario, phantom)),
+            stiffness_source=scenario.stiffness_source,
+            estimator=scenario.online_estimator,
+            online_surface=scenario.online_surface,
         ),
     )
     fdcc = builder.AddNamedSystem(
@@ -155,15 +170,21 @@ def MakeScanDiagram(scenario: Scenario, *, phantom=None, meshcat=None, data_dir=
     )
     # A nominal run's phantom stays put: a constant (C++) source, evaluated
     # for free every tick.
+    motion = patient_motion_source(scenario)
     lift = builder.AddNamedSystem(
         "phantom_lift",
-        ConstantVectorSource([0.0])
+        motion
+        if motion is not None
+        else ConstantVectorSource([0.0])
         if scenario.disturbance.is_nominal
         else PhantomLiftSource(scenario.disturbance),
     )
     demux = builder.AddNamedSystem("ur3e_state_demux", Demultiplexer([6, 6]))
 
-    force = station.GetOutputPort("ft_sensor.force_W")
+    # What the controllers read (through a FaultySensor with sensor faults).
+    force = add_sensor_faults(
+        builder, scenario, station.GetOutputPort("ft_sensor.force_W")
+    )
     if scenario.controller_feedback == "command":
         tip = builder.AddNamedSystem(
             "commanded_tip",
@@ -216,6 +237,13 @@ def MakeScanDiagram(scenario: Scenario, *, phantom=None, meshcat=None, data_dir=
         logger = LogVectorOutput(port, builder, scenario.logging.period_s)
         logger.set_name(f"log_{group.name}")
         loggers[group.name] = logger
+    loggers.update(
+        add_rig_loggers(
+            builder,
+            controller=controller,
+            period_s=scenario.logging.period_s,
+        )
+    )
     diagram = builder.Build()
     diagram.set_name("scan")
     return diagram, loggers

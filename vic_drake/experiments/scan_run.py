@@ -16,9 +16,11 @@ from pydrake.common import RandomGenerator
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
 
 from vic_drake.errors import VicDrakeError
+from vic_drake.experiments.rig_log import rig_frame
 from vic_drake.experiments.scan_diagram import (
     MakeScanDiagram,
     initial_joint_positions,
+    load_scenario_phantom,
     set_initial_state,
 )
 from vic_drake.experiments.scan_logs import logs_to_frame
@@ -39,6 +41,10 @@ class ScanResult:
         cpu_s: CPU time of this process during the simulation, s (on a
             loaded machine sim_s / cpu_s is the real-time factor the run
             would have with a core to itself).
+        rig: the signals only a rig log holds, sampled with ``df``
+            (:data:`vic_drake.analysis.rig_layout.RIG_SIGNALS`; ``attrs``
+            "beta": the phantom's exponent); see
+            :func:`vic_drake.experiments.rig_log.rig_log_rows`.
     """
 
     df: pd.DataFrame
@@ -48,6 +54,7 @@ class ScanResult:
     rtf: float
     build_s: float = 0.0
     cpu_s: float = float("nan")
+    rig: pd.DataFrame | None = None
 
 
 def run_scan(
@@ -76,6 +83,8 @@ def run_scan(
     if not duration > 0:
         raise VicDrakeError(f"duration_s must be > 0; got {duration_s!r}")
     t_build = time.perf_counter()
+    if phantom is None:
+        phantom = load_scenario_phantom(scenario, data_dir=data_dir)
     diagram, loggers = MakeScanDiagram(
         scenario, phantom=phantom, meshcat=meshcat, data_dir=data_dir
     )
@@ -103,6 +112,8 @@ def run_scan(
     cpu = time.process_time() - c0
     df = logs_to_frame(loggers, context)
     df.attrs.update(source="sim", scenario=scenario.name)
+    rig = rig_frame(loggers, context, len(df))
+    rig.attrs["beta"] = float(phantom.beta)
     return ScanResult(
         df=df,
         scenario=scenario,
@@ -111,6 +122,7 @@ def run_scan(
         rtf=duration / wall if wall > 0 else float("inf"),
         build_s=build_s,
         cpu_s=cpu,
+        rig=rig,
     )
 
 

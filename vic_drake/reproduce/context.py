@@ -18,7 +18,7 @@ import pandas as pd
 import yaml
 
 from vic_drake.errors import VicDrakeError
-from vic_drake.paths import has_data, resolve_data_dir
+from vic_drake.paths import find_data_dir
 from vic_drake.reproduce.options import ReproduceOptions
 from vic_drake.reproduce.report import ReportFigure
 
@@ -60,15 +60,17 @@ class RunContext:
     records: list[StageRecord] = field(default_factory=list)
     figures: list = field(default_factory=list)  # list[report.ReportFigure]
     tables: list = field(default_factory=list)  # list[report.ReportTable]
+    #: Where the stages write (the run's work folder; None: options.out_dir).
+    work_dir: Path | None = None
 
     @property
     def out_dir(self) -> Path:
-        return self.options.out_dir
+        """Where the stages write; renamed to ``options.out_dir`` at the end."""
+        return self.work_dir if self.work_dir is not None else self.options.out_dir
 
     @property
     def data_dir(self) -> Path | None:
-        d = resolve_data_dir(self.options.data_dir)
-        return d if has_data(d) else None
+        return find_data_dir(self.options.data_dir)
 
     @property
     def phantom_kind(self) -> str:
@@ -84,7 +86,13 @@ class RunContext:
             if r.name == name and not r.ok:
                 return r.error
         if name not in self.results:
-            return f"stage {name!r} did not run"
+            selected = self.options.stages
+            if selected is not None and name not in selected:
+                return (
+                    f"the {name} stage was not run (not in --stages "
+                    f"{','.join(selected)})"
+                )
+            return f"the {name} stage did not run"
         return None
 
     def add_figure(self, title: str, caption: str, fig, filename: str) -> Path:

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from vic_drake.errors import VicDrakeError
-from vic_drake.paths import has_data, resolve_data_dir
+from vic_drake.paths import check_data_dir, has_data, resolve_data_dir
 
 
 @dataclass
@@ -22,6 +22,8 @@ class ReproduceOptions:
         phantom: "auto" (measured map when the data is there, else synthetic),
             "measured" or "synthetic".
         stages: names of the stages to run (None: all).
+        meshcat: keep the replay's Meshcat server for a live view (the result's
+            ``results["replay"]["meshcat"]``).
         progress: called with one line of progress text.
     """
 
@@ -30,6 +32,7 @@ class ReproduceOptions:
     quick: bool = False
     phantom: str = "auto"
     stages: tuple[str, ...] | None = None
+    meshcat: bool = False
     progress: Callable[[str], None] = lambda message: None
 
     def __post_init__(self):
@@ -38,12 +41,7 @@ class ReproduceOptions:
             raise VicDrakeError(
                 f"phantom must be 'auto', 'measured' or 'synthetic', got {self.phantom!r}"
             )
-        if self.data_dir is not None and not has_data(self.data_dir):
-            raise VicDrakeError(
-                f"--data-dir {str(self.data_dir)!r} does not hold the paper's data; expected "
-                "phantom_map/, experiments/, palpation/ and loadcycle/ in it (omit the "
-                "option to run on the synthetic phantom)"
-            )
+        check_data_dir(self.data_dir)
         if self.phantom == "measured" and not has_data(self.data_dir):
             raise VicDrakeError(
                 f"--phantom measured needs the paper's phantom map; none found at "

@@ -4,12 +4,11 @@
 times each, shows progress, and records a stage that fails (its error
 message, the traceback in ``logs/errors.txt``) instead of stopping: the
 claims that need a failed stage are then reported as not evaluated, with the
-reason, and fail. :func:`reproduce` is the library entry point.
+reason (never as a fail). :func:`reproduce` is the library entry point.
 """
 
 from __future__ import annotations
 
-import json
 import time
 import traceback
 from collections.abc import Callable
@@ -17,9 +16,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from vic_drake.errors import VicDrakeError
+from vic_drake.analysis.claims import PASS, claim_status
 from vic_drake.reproduce.context import RunContext, StageRecord, StageSkipped
 from vic_drake.reproduce.options import ReproduceOptions
+from vic_drake.reproduce.run_dir import RUN_FILE, finish_run_dir, prepare_run_dir
 from vic_drake.reproduce.stages.claims import stage_claims
 from vic_drake.reproduce.stages.compare_real import stage_compare_real
 from vic_drake.reproduce.stages.map import stage_map
@@ -55,13 +55,21 @@ class ReproduceResult:
     report_path: Path | None
     results: dict
 
+    @property
+    def all_claims_pass(self) -> bool:
+        """True when there are claims and every one passed."""
+        return bool(self.claims) and all(
+            claim_status(c) == PASS for c in self.claims.values()
+        )
+
     def summary(self) -> dict:
         return {
             "out_dir": str(self.out_dir),
             "report": str(self.report_path) if self.report_path else None,
             "wall_s": round(self.wall_s, 1),
             "stages": [r.as_dict() for r in self.records],
-            "claims": {k: bool(v["pass"]) for k, v in self.claims.items()},
+            "claims": {k: claim_status(v) for k, v in self.claims.items()},
+            "all_claims_pass": self.all_claims_pass,
         }
 
 
@@ -96,36 +104,38 @@ def run_pipeline(ctx: RunContext) -> None:
 def reproduce(options: ReproduceOptions) -> ReproduceResult:
     """Runs the reproduction; returns the claims and where everything is.
 
+    The outputs are written through a work folder and moved to
+    ``options.out_dir`` only when every selected stage has run
+    (:mod:`vic_drake.reproduce.run_dir`); an interrupted run leaves the
+    previous run in ``out_dir`` whole.
+
     Raises:
-        VicDrakeError: the output folder cannot be created.
+        VicDrakeError: the output folder cannot be used (checked before any
+            work).
     """
-    try:
-        options.out_dir.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise VicDrakeError(
-            f"cannot create the output folder {str(options.out_dir)!r}: {exc.strerror}"
-        ) from None
-    err_log = options.out_dir / "logs" / "errors.txt"
-    if err_log.exists():
-        err_log.unlink()
-    ctx = RunContext(options)
+    work = prepare_run_dir(options.out_dir)
+    ctx = RunContext(options, work_dir=work)
     t0 = time.perf_counter()
-    run_pipeline(ctx)
-    wall = time.perf_counter() - t0
-    (options.out_dir / "run.json").write_text(
-        json.dumps(
-            {
-                "wall_s": round(wall, 2),
-                "quick": options.quick,
-                "stages": [r.as_dict() for r in ctx.records],
-            },
-            indent=2,
+    try:
+        run_pipeline(ctx)
+    except BaseException:
+        options.progress(
+            f"run stopped; its partial outputs are in {str(work)!r}, marked "
+            f"incomplete ({RUN_FILE}); {str(options.out_dir)!r} is unchanged"
         )
-        + "\n",
-        encoding="utf-8",
-    )
+        raise
+    wall = time.perf_counter() - t0
     claims = (ctx.results.get("claims") or {}).get("claims", {})
-    report = (ctx.results.get("report") or {}).get("path")
-    return ReproduceResult(
-        options.out_dir, claims, ctx.records, wall, report, ctx.results
+    out = finish_run_dir(
+        work,
+        options.out_dir,
+        wall_s=round(wall, 2),
+        quick=options.quick,
+        stages=[r.as_dict() for r in ctx.records],
+        claims={k: claim_status(v) for k, v in claims.items()},
     )
+    for value in ctx.results.values():  # Paths into the work folder -> out.
+        if isinstance(value, dict) and isinstance(value.get("path"), Path):
+            value["path"] = out / value["path"].relative_to(work)
+    report = (ctx.results.get("report") or {}).get("path")
+    return ReproduceResult(out, claims, ctx.records, wall, report, ctx.results)

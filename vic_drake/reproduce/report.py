@@ -23,6 +23,8 @@ from typing import Any
 
 import numpy as np
 
+from vic_drake.analysis.claims.claim import FAIL, NOT_EVALUATED, PASS, claim_status
+
 
 @dataclass
 class ReportFigure:
@@ -91,15 +93,22 @@ class ReportContent:
 
 _CSS = """
 body{font-family:system-ui,-apple-system,Segoe UI,Helvetica,Arial,sans-serif;margin:2em auto;
-max-width:1100px;color:#222;line-height:1.4;padding:0 1em}
+max-width:1300px;color:#222;line-height:1.4;padding:0 1em}
 h1{font-size:1.6em}h2{border-bottom:1px solid #ccc;padding-bottom:.2em;margin-top:1.6em}
-table{border-collapse:collapse;margin:.6em 0;font-size:.9em;width:100%}
-th,td{border:1px solid #ccc;padding:.3em .5em;vertical-align:top;text-align:left}
+.tablewrap{overflow-x:auto;max-width:100%;margin:.6em 0}
+table{border-collapse:collapse;font-size:.9em;width:100%}
+th,td{border:1px solid #ccc;padding:.3em .5em;vertical-align:top;text-align:left;
+overflow-wrap:break-word}
+td.pass,td.fail,td.ne,td.na{white-space:nowrap}
+td.stmt{width:24%}
+th{font-size:.92em}
 th{background:#f3f3f3}
 td.pass{background:#dff5df;font-weight:bold;color:#175c17}
 td.fail{background:#fadede;font-weight:bold;color:#8a1414}
 td.na{color:#777}
-pre.val{margin:0;font-size:.85em;white-space:pre-wrap;font-family:ui-monospace,Menlo,Consolas,monospace}
+td.ne{background:#f0f0f0;color:#555;font-style:italic}
+pre.val{margin:0;font-size:.85em;white-space:pre-wrap;overflow-wrap:anywhere;
+font-family:ui-monospace,Menlo,Consolas,monospace}
 figure{margin:1em 0;page-break-inside:avoid}figure img{max-width:100%;border:1px solid #eee}
 figcaption{font-size:.9em;color:#444}
 .small{font-size:.85em;color:#555}
@@ -149,8 +158,21 @@ def _cell(value: Any) -> str:
 
 def _pass_cell(ok: bool | None) -> str:
     if ok is None:
-        return '<td class="na">n/a</td>'
+        return '<td class="na">not evaluated</td>'
     return '<td class="pass">PASS</td>' if ok else '<td class="fail">FAIL</td>'
+
+
+def _status_cell(status: str) -> str:
+    if status == PASS:
+        return '<td class="pass">PASS</td>'
+    if status == FAIL:
+        return '<td class="fail">FAIL</td>'
+    return '<td class="ne">not evaluated</td>'
+
+
+def _wrap(table: str) -> str:
+    """A table in a box that scrolls sideways when it is wider than the page."""
+    return f'<div class="tablewrap">{table}</div>'
 
 
 def claims_table_html(claims: Mapping[str, Mapping]) -> str:
@@ -161,22 +183,27 @@ def claims_table_html(claims: Mapping[str, Mapping]) -> str:
         rows.append(
             "<tr>"
             f"<td><b>{html.escape(cid)}</b></td>"
-            f"<td>{html.escape(str(c.get('statement', '')))}"
+            f'<td class="stmt">{html.escape(str(c.get("statement", "")))}'
             f'<div class="small">{html.escape(detail)}</div></td>'
             f"{_cell(c.get('paper'))}{_cell(c.get('sim'))}{_cell(c.get('real'))}"
             f"{_pass_cell(c.get('pass_sim'))}{_pass_cell(c.get('pass_real'))}"
-            f"{_pass_cell(bool(c.get('pass')))}"
+            f"{_status_cell(claim_status(c))}"
             "</tr>"
         )
     head = (
         "<tr><th>id</th><th>claim</th><th>paper</th><th>simulation</th>"
-        "<th>real measurement</th><th>sim</th><th>real</th><th>pass</th></tr>"
+        "<th>real measurement</th><th>sim</th><th>real</th><th>verdict</th></tr>"
     )
-    return f"<table>{head}{''.join(rows)}</table>"
+    return _wrap(f"<table>{head}{''.join(rows)}</table>")
+
+
+def _header(name: str) -> str:
+    """A column name that may break after its underscores."""
+    return html.escape(name).replace("_", "_<wbr>")
 
 
 def table_html(table: ReportTable) -> str:
-    head = "".join(f"<th>{html.escape(str(c))}</th>" for c in table.columns)
+    head = "".join(f"<th>{_header(str(c))}</th>" for c in table.columns)
     body = "".join(
         "<tr>"
         + "".join(f"<td>{html.escape(format_value(v))}</td>" for v in row)
@@ -185,7 +212,9 @@ def table_html(table: ReportTable) -> str:
     )
     cap = f'<p class="small">{html.escape(table.caption)}</p>' if table.caption else ""
     return (
-        f"<h3>{html.escape(table.title)}</h3><table><tr>{head}</tr>{body}</table>{cap}"
+        f"<h3>{html.escape(table.title)}</h3>"
+        + _wrap(f"<table><tr>{head}</tr>{body}</table>")
+        + cap
     )
 
 
@@ -208,13 +237,19 @@ def render_report(content: ReportContent) -> str:
     if content.summary:
         parts.append(f"<p>{html.escape(content.summary)}</p>")
     if content.claims:
-        n_pass = sum(bool(c.get("pass")) for c in content.claims.values())
-        parts.append(f"<h2>Claims ({n_pass} of {len(content.claims)} pass)</h2>")
+        statuses = [claim_status(c) for c in content.claims.values()]
+        n = {s: statuses.count(s) for s in (PASS, FAIL, NOT_EVALUATED)}
+        head = f"Claims ({n[PASS]} of {len(statuses)} pass"
+        head += f", {n[FAIL]} fail" if n[FAIL] else ""
+        head += f", {n[NOT_EVALUATED]} not evaluated" if n[NOT_EVALUATED] else ""
+        parts.append(f"<h2>{head})</h2>")
         parts.append(claims_table_html(content.claims))
         parts.append(
-            '<p class="small">pass = every evaluated side (simulation, real logs) passes '
-            "and at least one side was evaluated; — = not evaluated (reason in the claim's "
-            "note). The machine-readable table is claims.json.</p>"
+            '<p class="small">verdict: PASS = the simulation shows the claim and the real '
+            "logs, where evaluated, do not contradict it; FAIL = an evaluated side "
+            "contradicts it; not evaluated = the simulation could not be evaluated (the "
+            "reason is in the claim's note). The machine-readable table is claims.json "
+            '("status").</p>'
         )
     if content.notes:
         parts.append("<h2>How to read this</h2><ul>")
@@ -254,12 +289,12 @@ def render_report(content: ReportContent) -> str:
             )
         )
     if content.metadata:
-        parts.append("<h2>Run</h2><table>")
+        parts.append('<h2>Run</h2><div class="tablewrap"><table>')
         parts.extend(
             f"<tr><th>{html.escape(str(k))}</th><td>{html.escape(format_value(v))}</td></tr>"
             for k, v in content.metadata.items()
         )
-        parts.append("</table>")
+        parts.append("</table></div>")
     parts.append("</body></html>")
     return "\n".join(parts)
 

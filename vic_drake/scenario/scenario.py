@@ -24,12 +24,14 @@ from vic_drake.control.params import (
     StiffnessQpParams,
 )
 from vic_drake.errors import VicDrakeError
+from vic_drake.estimation.online import OnlineEstimatorParams
 from vic_drake.scenario.checks import check_number
 from vic_drake.scenario.disturbance import DisturbanceConfig
 from vic_drake.scenario.logging import LoggingConfig
 from vic_drake.scenario.phantom import PhantomConfig
 from vic_drake.scenario.plain import as_plain
 from vic_drake.scenario.trajectory import TrajectoryConfig
+from vic_drake.scenario.variation import VariationConfig
 from vic_drake.station.params import StationParams
 
 #: The stiffness QP solver of the scans: the closed-form solver (the same K
@@ -41,6 +43,15 @@ SCAN_QP_SOLVER = "exact"
 
 #: Where the controller reads the probe's position and velocity.
 CONTROLLER_FEEDBACKS = ("measured", "command")
+
+#: Where the VS controllers take kappa, lambda and the surface from: the
+#: tissue map, or the online estimator (no map; seeded with a prior).
+STIFFNESS_SOURCES = ("map", "online")
+
+
+def _online_estimator() -> OnlineEstimatorParams:
+    """The closed loop's estimator: the EKF with a surface state (no map surface)."""
+    return OnlineEstimatorParams(method="ekf", surface_walk_m_per_sqrt_s=0.001)
 
 
 def _vs_vf_controller() -> ControllerParams:
@@ -142,6 +153,18 @@ class Scenario:
     controller_feedback: str = "measured"
     seed: int = 0  # Seed of the random elements (sensor noise), >= 0.
     duration_s: float | None = None  # Simulated time, s (None: trajectory end + 1 s).
+    # Patient, motion, sensor faults, map errors (all off by default; see
+    # vic_drake.scenario.variation).
+    variations: VariationConfig = field(default_factory=VariationConfig)
+    # Where kappa, lambda and the surface of the force references and the
+    # stiffness QP come from: "map" (the phantom's map, with its errors) or
+    # "online" (online_estimator, seeded with its prior; no map read).
+    stiffness_source: str = "map"
+    online_estimator: OnlineEstimatorParams = field(default_factory=_online_estimator)
+    # With "online": where the estimator's surface comes from, "estimated"
+    # (latched at first contact, no map at all) or "map" (the map's surface
+    # under the probe; kappa and lambda still online).
+    online_surface: str = "estimated"
 
     def __post_init__(self):
         self.validate()
@@ -165,6 +188,8 @@ class Scenario:
             ("trajectory", TrajectoryConfig),
             ("disturbance", DisturbanceConfig),
             ("logging", LoggingConfig),
+            ("variations", VariationConfig),
+            ("online_estimator", OnlineEstimatorParams),
         )
         for name, kind in parts:
             _validate_part(o, name, getattr(self, name), kind)
@@ -173,6 +198,16 @@ class Scenario:
                 f"{o}.simulator must be a SimulatorConfig; got {self.simulator!r}"
             )
         _validate_simulator(o, self.simulator)
+        if self.online_surface not in ("estimated", "map"):
+            raise VicDrakeError(
+                f"{o}.online_surface must be 'estimated' or 'map'; "
+                f"got {self.online_surface!r}"
+            )
+        if self.stiffness_source not in STIFFNESS_SOURCES:
+            raise VicDrakeError(
+                f"{o}.stiffness_source must be one of {list(STIFFNESS_SOURCES)}; "
+                f"got {self.stiffness_source!r}"
+            )
         if self.controller_feedback not in CONTROLLER_FEEDBACKS:
             raise VicDrakeError(
                 f"{o}.controller_feedback must be 'measured' or 'command'; "
@@ -186,6 +221,11 @@ class Scenario:
             raise VicDrakeError(f"{o}.seed must be an integer >= 0; got {self.seed!r}")
         if self.duration_s is not None:
             check_number(o, "duration_s", self.duration_s, low=0.0, low_open=True)
+        if self.variations.patient.enabled and self.phantom.kind != "synthetic":
+            raise VicDrakeError(
+                f"{o}.variations.patient needs phantom.kind 'synthetic' (a "
+                f"patient is a synthetic chest); got {self.phantom.kind!r}"
+            )
         return self
 
     def __eq__(self, other):

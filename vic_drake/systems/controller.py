@@ -21,6 +21,8 @@ from pydrake.systems.framework import Diagram, DiagramBuilder
 
 from vic_drake.control.params import ControllerParams
 from vic_drake.errors import VicDrakeError
+from vic_drake.estimation.online import OnlineEstimatorParams
+from vic_drake.systems.online_estimator import OnlineEstimatorSystem
 from vic_drake.systems.references import ForceReferenceSystem
 from vic_drake.systems.signals import STATUS_FIELDS, TANK_FIELDS
 from vic_drake.systems.stiffness_qp import StiffnessQpSystem
@@ -35,14 +37,28 @@ __all__ = [
 
 
 def MakeVariableImpedanceController(
-    params: ControllerParams, *, phantom: Phantom
+    params: ControllerParams,
+    *,
+    phantom: Phantom | None,
+    stiffness_source: str = "map",
+    estimator: OnlineEstimatorParams | None = None,
+    online_surface: str = "estimated",
 ) -> Diagram:
     """Builds the online controller.
 
     Args:
         params: controller parameters (validated here again, so values loaded
             from YAML are checked).
-        phantom: the tissue map the references read (surface, kappa, lam).
+        phantom: the tissue map the references read (surface, kappa, lam);
+            may be None with ``stiffness_source="online"``.
+        stiffness_source: "map" or "online": kappa, lam and the surface come
+            from an OnlineEstimatorSystem ("tissue_estimator", fed by the
+            probe and the sensor, seeded with the estimator's prior) and the
+            diagram exports its "tissue_estimate" (7) output too.
+        estimator: the estimator's settings (needed with "online").
+        online_surface: with "online": "estimated" (latched at first
+            contact; the phantom is not read) or "map" (the estimator reads
+            the phantom's surface under the probe; kappa, lam still online).
 
     Returns:
         Diagram "variable_impedance_controller" with
@@ -51,7 +67,10 @@ def MakeVariableImpedanceController(
         W, sensor convention: negative z = pressing);
         outputs: "stiffness" (3, N/m), "damping" (3, N s/m), "target_force"
         (3, N), "force_reference" (3, N), "force_min" (3, N), "tank" (4:
-        :data:`TANK_FIELDS`), "status" (6: :data:`STATUS_FIELDS`). All but
+        :data:`TANK_FIELDS`), "status" (6: :data:`STATUS_FIELDS`),
+        "contact" (4: :data:`vic_drake.systems.signals.CONTACT_FIELDS`),
+        "tick_record" (11: :data:`vic_drake.systems.signals.TICK_RECORD_FIELDS`,
+        what the tick read and its map sample). All but
         "target_force" (direct feedthrough, read by the compliance stage in
         the same tick) describe the last tick (from state):
         force_reference and force_min are what that tick's QP used.
@@ -60,21 +79,56 @@ def MakeVariableImpedanceController(
         raise VicDrakeError(
             f"MakeVariableImpedanceController needs ControllerParams; got {params!r}"
         )
-    if not isinstance(phantom, Phantom):
+    online = stiffness_source == "online"
+    if online and not isinstance(estimator, OnlineEstimatorParams):
+        raise VicDrakeError(
+            f"stiffness_source 'online' needs estimator=OnlineEstimatorParams; got {estimator!r}"
+        )
+    if online_surface not in ("estimated", "map"):
+        raise VicDrakeError(
+            f"online_surface must be 'estimated' or 'map'; got {online_surface!r}"
+        )
+    if (not online or online_surface == "map") and not isinstance(phantom, Phantom):
         raise VicDrakeError(f"phantom must be a vic_drake Phantom; got {phantom!r}")
     params.validate()
     builder = DiagramBuilder()
     ref = builder.AddNamedSystem(
-        "force_reference", ForceReferenceSystem(params, phantom=phantom)
+        "force_reference",
+        ForceReferenceSystem(
+            params,
+            phantom=phantom,
+            stiffness_source=stiffness_source,
+            beta=estimator.beta if online else None,
+        ),
     )
+    if online:
+        est = builder.AddNamedSystem(
+            "tissue_estimator",
+            OnlineEstimatorSystem(
+                estimator,
+                period_s=params.period_s,
+                surface_input=False,
+                surface_map=phantom if online_surface == "map" else None,
+            ),
+        )
+        builder.Connect(
+            est.get_estimate_output_port(), ref.GetInputPort("tissue.estimate")
+        )
+        builder.ExportOutput(est.get_estimate_output_port(), "tissue_estimate")
     qp = builder.AddNamedSystem("stiffness_qp", StiffnessQpSystem(params))
     tank = builder.AddNamedSystem("energy_tank", EnergyTankSystem(params))
 
     for name in ("probe.position", "probe.velocity"):
         index = builder.ExportInput(ref.GetInputPort(name), name)
         builder.ConnectInput(index, qp.GetInputPort(name))
+        if online:
+            builder.ConnectInput(index, est.GetInputPort(name))
     builder.ExportInput(qp.GetInputPort("target_position"), "target_position")
-    builder.ExportInput(ref.GetInputPort("ft_sensor.force_W"), "ft_sensor.force_W")
+    index = builder.ExportInput(
+        ref.GetInputPort("ft_sensor.force_W"), "ft_sensor.force_W"
+    )
+    if online:
+        builder.ConnectInput(index, est.GetInputPort("ft_sensor.force_W"))
 
     builder.Connect(ref.get_references_output_port(), qp.GetInputPort("references"))
     builder.Connect(tank.get_energy_output_port(), qp.GetInputPort("tank_energy"))
@@ -85,6 +139,8 @@ def MakeVariableImpedanceController(
     builder.ExportOutput(ref.get_target_force_output_port(), "target_force")
     builder.ExportOutput(ref.get_force_reference_output_port(), "force_reference")
     builder.ExportOutput(ref.get_force_min_output_port(), "force_min")
+    builder.ExportOutput(ref.get_contact_output_port(), "contact")
+    builder.ExportOutput(ref.get_tick_record_output_port(), "tick_record")
     builder.ExportOutput(tank.get_tank_output_port(), "tank")
     builder.ExportOutput(qp.get_status_output_port(), "status")
     diagram = builder.Build()

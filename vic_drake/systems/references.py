@@ -33,6 +33,8 @@ from vic_drake.control.references import (
     surface_velocity_initial_state,
     surface_velocity_step,
 )
+from vic_drake.errors import VicDrakeError
+from vic_drake.estimation.online import OUTPUT_FIELDS as ESTIMATE_FIELDS
 from vic_drake.systems.signals import (
     REF_CONTACT,
     REF_FAULT,
@@ -43,8 +45,12 @@ from vic_drake.systems.signals import (
     REF_SURFACE_VELOCITY,
     REF_TARGET_FORCE,
     REFERENCES_SIZE,
+    TICK_RECORD_SIZE,
 )
 from vic_drake.tissue.phantom import Phantom
+
+#: The map sample of a faulty tick (no lookup was made).
+_NO_SAMPLE = (math.nan, math.nan)
 
 
 class ForceReferenceSystem(LeafSystem):
@@ -66,6 +72,10 @@ class ForceReferenceSystem(LeafSystem):
         force_min (3): F_min, N.
         contact (4): :data:`vic_drake.systems.signals.CONTACT_FIELDS`
             (in_contact, penetration_m, fault, surface_velocity_m_per_s).
+        tick_record (11): :data:`vic_drake.systems.signals.TICK_RECORD_FIELDS`,
+            the position, velocity and force the tick read and the map's
+            kappa and lambda its lookup returned (NaN on a faulty tick): what
+            the real controller logged of its tick (the rig log layout).
 
     State: the surface-velocity filter and the last tick's F_ref, F_min,
     contact (discrete, updated every period).
@@ -73,20 +83,60 @@ class ForceReferenceSystem(LeafSystem):
     -F_max,z), target 0, in_contact 0 and fault 1 (never a NaN output).
     """
 
-    def __init__(self, params: ControllerParams, *, phantom: Phantom):
+    def __init__(
+        self,
+        params: ControllerParams,
+        *,
+        phantom: Phantom | None,
+        stiffness_source: str = "map",
+        beta: float | None = None,
+    ):
+        """``stiffness_source="online"``: kappa, lam and the surface come from
+        the "tissue.estimate" input (an OnlineEstimatorSystem's "estimate"
+        port) instead of the phantom (which may then be None); ``beta`` is
+        the estimator's exponent. A NaN estimated surface gives a zero
+        surface rate.
+        """
         super().__init__()
         # A private copy: later edits of the caller's (mutable) params cannot
         # change a built system.
         params = copy.deepcopy(params).validate()
         self._params = params
         self._phantom = phantom
-        self._sample = scalar_sampler(phantom)
+        self._online = stiffness_source == "online"
+        if stiffness_source not in ("map", "online"):
+            raise VicDrakeError(
+                f"stiffness_source must be 'map' or 'online'; got {stiffness_source!r}"
+            )
+        if self._online:
+            if beta is None or not (0.0 < float(beta) <= 3.0):
+                raise VicDrakeError(
+                    f"online references need beta in (0, 3]; got {beta!r}"
+                )
+            if params.reference.surface_velocity_mode != "moving_average":
+                raise VicDrakeError(
+                    "online references need reference.surface_velocity_mode "
+                    "'moving_average' (no map gradient without a map); got "
+                    f"{params.reference.surface_velocity_mode!r}"
+                )
+            self._beta = float(beta)
+            self._sample = None
+        else:
+            if phantom is None:
+                raise VicDrakeError("map references need a phantom")
+            self._beta = phantom.beta
+            self._sample = scalar_sampler(phantom)
         self._dt = float(params.period_s)
         ref = params.reference
         self._mode = ref.surface_velocity_mode
         self._position_port = self.DeclareVectorInputPort("probe.position", 3)
         self._velocity_port = self.DeclareVectorInputPort("probe.velocity", 3)
         self._force_port = self.DeclareVectorInputPort("ft_sensor.force_W", 3)
+        self._estimate_port = (
+            self.DeclareVectorInputPort("tissue.estimate", len(ESTIMATE_FIELDS))
+            if self._online
+            else None
+        )
         self._filter_index = self.DeclareDiscreteState(
             surface_velocity_initial_state(ref.surface_velocity_window)
         )
@@ -117,6 +167,12 @@ class ForceReferenceSystem(LeafSystem):
         ):
             self._last[name] = (self.DeclareDiscreteState(part.stop - part.start), part)
             self._outputs[name] = self.DeclareStateOutputPort(name, self._last[name][0])
+        self._record_index = self.DeclareDiscreteState(
+            np.full(TICK_RECORD_SIZE, np.nan)
+        )
+        self._outputs["tick_record"] = self.DeclareStateOutputPort(
+            "tick_record", self._record_index
+        )
 
     def _make_output(self, part: slice):
         def calc(context, output: BasicVector):
@@ -137,7 +193,7 @@ class ForceReferenceSystem(LeafSystem):
         return values
 
     def _evaluate(self, context):
-        """(values (REFERENCES_SIZE,), new filter state) for the current inputs."""
+        """(values (REFERENCES_SIZE,), new filter state, tick record) now."""
         p_WP = self._position_port.Eval(context).tolist()
         v_WP = self._velocity_port.Eval(context).tolist()
         f_W = self._force_port.Eval(context).tolist()
@@ -147,9 +203,29 @@ class ForceReferenceSystem(LeafSystem):
         if not math.isfinite(sum(p_WP) + sum(v_WP) + sum(f_W)):
             # Restart the filter: the next good sample only records its height
             # (no rate spike across the gap).
-            return self._safe_values(), [0.0, *filt[1:]]
-        surface_z, dz_dx, dz_dy, kappa, lam = self._sample(p_WP[0], p_WP[1])
-        if self._mode == "moving_average":
+            return (
+                self._safe_values(),
+                [0.0, *filt[1:]],
+                [*p_WP, *v_WP, *f_W, *_NO_SAMPLE],
+            )
+        if self._online:
+            est = self._estimate_port.Eval(context)
+            kappa = float(est[0])
+            lam = float(est[1])
+            surface_z = float(est[ESTIMATE_FIELDS.index("surface_z_m")])
+            dz_dx = dz_dy = 0.0
+        else:
+            surface_z, dz_dx, dz_dy, kappa, lam = self._sample(p_WP[0], p_WP[1])
+        if not math.isfinite(surface_z):  # Online, before contact: no surface.
+            # Zero penetration and rate; restart the filter so that the
+            # surface latched at contact is not read as a jump.
+            filt = [0.0, *filt[1:]]
+            surface_z, dz_dx, dz_dy = p_WP[2], 0.0, 0.0
+            if self._mode == "moving_average":
+                filt[0] = -1.0  # Marks "restart after this tick" (below).
+        if self._mode == "moving_average" and filt[0] < 0.0:
+            new_filt, z_surf_dot = [0.0, *filt[1:]], 0.0
+        elif self._mode == "moving_average":
             new_filt, z_surf_dot = surface_velocity_step(filt, surface_z, self._dt)
         else:
             new_filt = filt
@@ -160,7 +236,7 @@ class ForceReferenceSystem(LeafSystem):
             kappa=kappa,
             lam=lam,
             eps_dot=penetration_rate(v_WP[2], z_surf_dot),
-            beta=self._phantom.beta,
+            beta=self._beta,
             ref=ref,
             qp=qp,
         )
@@ -173,15 +249,16 @@ class ForceReferenceSystem(LeafSystem):
         values[REF_FAULT] = 0.0
         values[REF_SURFACE_VELOCITY] = z_surf_dot
         if not math.isfinite(sum(values)):  # E.g. a phantom returning NaN.
-            return self._safe_values(), new_filt
-        return np.array(values), new_filt
+            return self._safe_values(), new_filt, [*p_WP, *v_WP, *f_W, *_NO_SAMPLE]
+        return np.array(values), new_filt, [*p_WP, *v_WP, *f_W, kappa, lam]
 
     def _calc(self, context, value):
         value.set_value(self._evaluate(context))
 
     def _update(self, context, discrete_state):
-        values, new_filt = self._cache.Eval(context)
+        values, new_filt, record = self._cache.Eval(context)
         discrete_state.set_value(self._filter_index, new_filt)
+        discrete_state.set_value(self._record_index, record)
         for index, part in self._last.values():
             discrete_state.set_value(index, values[part])
 
@@ -205,6 +282,9 @@ class ForceReferenceSystem(LeafSystem):
 
     def get_contact_output_port(self):
         return self._outputs["contact"]
+
+    def get_tick_record_output_port(self):
+        return self._outputs["tick_record"]
 
     def get_references_output_port(self):
         return self._outputs["references"]

@@ -27,6 +27,26 @@ from __future__ import annotations
 CONTACT_FIELDS = ("in_contact", "penetration_m", "fault", "surface_velocity_m_per_s")
 CONTACT_SIZE = len(CONTACT_FIELDS)
 
+#: Elements of ForceReferenceSystem's "tick_record" port, in order: what
+#: the tick read (probe position p_WP, m; velocity v_WP, m/s; F/T force in
+#: W, N, sensor convention) and what its map lookup returned (Hunt-Crossley
+#: kappa, N/m^beta; lambda, N s/m^(beta+1)): the real controller's log
+#: columns 1-3, 27-29, 8-10, 20-21.
+TICK_RECORD_FIELDS = (
+    "x_m",
+    "y_m",
+    "z_m",
+    "vx_m_per_s",
+    "vy_m_per_s",
+    "vz_m_per_s",
+    "force_x_N",
+    "force_y_N",
+    "force_z_N",
+    "kappa",
+    "lambda",
+)
+TICK_RECORD_SIZE = len(TICK_RECORD_FIELDS)
+
 #: The "references" port: F_ref (3, N), F_min (3, N), the FDCC target force
 #: (3, N), then the :data:`CONTACT_FIELDS`.
 REFERENCES_SIZE = 9 + CONTACT_SIZE

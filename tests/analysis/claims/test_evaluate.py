@@ -10,3 +10,4 @@ def test_evaluate_claims_json_shape():
     for c in d.values():
         assert c["pass"] is False and c["sim"] is None
         assert "nothing ran" in c["detail"]
+        assert c["status"] == "not evaluated"

@@ -102,3 +102,14 @@ def test_c3_equal_ribs_or_no_ribs_fail():
     assert flat["n_ribs"] == 0 and not C.claim_c3(flat, None).pass_sim
     with pytest.raises(VicDrakeError, match="shape"):
         rib_prominences(np.zeros(3), np.zeros(2), np.zeros((2, 3)))
+
+
+def test_c2_decay_is_the_fit_fig3_draws():
+    """One number per fitted quantity: claims.json's a, tau, c are Fig. 3's."""
+    from vic_drake.estimation.palpation import fit_exponential
+
+    t = np.linspace(1.0, 20.0, 12)
+    r = 0.02 + 0.05 * np.exp(-t / 4.0) + 1e-4 * np.sin(7 * t)
+    d = C.residual_decay(t, r)
+    f = fit_exponential(t, r)
+    assert (d["a"], d["tau_s"], d["c"]) == (f.a, f.tau_s, f.c)

@@ -96,6 +96,56 @@ def test_c6_penetration_and_cap():
     assert not C.claim_c6(deep, None).passed
 
 
+def test_c6_scan_off_the_ribs_is_not_evaluated_and_says_what_happened():
+    """A VS-VF scan whose reference never reaches the cap cannot test the cap:
+    not evaluated (never FAIL), with the scan's own numbers in the reason."""
+    t = np.arange(0, 10, 0.01)
+    df = _scan(
+        np.full(t.size, 6.0),
+        t=t,
+        ref=np.full(t.size, 6.0),
+        force_min_z_N=-9.0,
+        penetration_m=np.full(t.size, 0.0079),
+    )
+    m = C.scan_metrics(df, limits=C.ScanLimits(eps_d_m=0.008))
+    claim = C.claim_c6(m, None)
+    assert claim.status == C.NOT_EVALUATED and not claim.passed
+    assert claim.pass_sim is None and claim.sim["n_on_ribs"] == 0
+    assert "exceeded the cap |F_min| on only 0 samples" in claim.detail
+    assert "median |eps - eps_d| = 0.10 mm" in claim.detail
+    assert "result missing" not in claim.detail
+    # The penetration half alone can still fail the claim.
+    deep = C.scan_metrics(
+        _scan(
+            np.full(t.size, 6.0),
+            t=t,
+            ref=np.full(t.size, 6.0),
+            force_min_z_N=-9.0,
+            penetration_m=np.full(t.size, 0.013),
+        ),
+        limits=C.ScanLimits(eps_d_m=0.008),
+    )
+    assert C.claim_c6(deep, None).status == C.FAIL
+
+
+def test_claim_status_three_ways():
+    cs, vscf = {"force_range_N": 4.0}, {"force_range_N": 1.0}
+    assert C.claim_c5({"cs": cs, "vs-cf": vscf}, None).status == C.PASS
+    assert C.claim_c5({"cs": {"force_range_N": 1.5}, "vs-cf": vscf}, None).status == (
+        C.FAIL
+    )
+    missing = C.claim_c5({"cs": cs}, None)
+    assert missing.status == C.NOT_EVALUATED and "no VS-CF scan" in missing.detail
+    absent = C.claim_c5(None, None, reason_sim="the scans stage was not selected")
+    d = absent.to_dict()
+    assert d["status"] == "not evaluated" and d["pass"] is False
+    assert "the scans stage was not selected" in d["detail"]
+    # A real side that contradicts the claim is a fail even without a simulation.
+    assert C.claim_c5(None, {"cs": {"force_range_N": 1.5}, "vs-cf": vscf}).status == (
+        C.FAIL
+    )
+
+
 def _disturbed(peak=8.0, k_lost=100.0, power_min=-0.09, tank_min=0.45):
     t = np.arange(0, 10, 0.01)
     lost = (t > 4) & (t < 5)

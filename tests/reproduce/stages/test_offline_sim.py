@@ -7,7 +7,9 @@ from vic_drake.reproduce import ReproduceOptions, reproduce
 
 def test_offline_sim_stage_evaluates_c1_and_c2(tmp_path, monkeypatch):
     """Palpations simulated on the synthetic chest (no data needed)."""
-    monkeypatch.setenv("VIC_DRAKE_DATA", str(tmp_path / "no_data"))
+    # A clone without the data: no $VIC_DRAKE_DATA, no ../shared/data.
+    monkeypatch.delenv("VIC_DRAKE_DATA", raising=False)
+    monkeypatch.setattr("vic_drake.paths.DEFAULT_DATA_DIR", tmp_path / "no_data")
     out = tmp_path / "out"
     result = reproduce(
         ReproduceOptions(

@@ -8,7 +8,14 @@ the paper's measurements exist, for the real rig, and returns a
 real value and whether the claim holds.
 """
 
-from vic_drake.analysis.claims.claim import Claim, claims_to_json_dict
+from vic_drake.analysis.claims.claim import (
+    FAIL,
+    NOT_EVALUATED,
+    PASS,
+    Claim,
+    claim_status,
+    claims_to_json_dict,
+)
 from vic_drake.analysis.claims.evaluate import ClaimInputs, evaluate_claims
 from vic_drake.analysis.claims.offline import (
     ModelResiduals,
@@ -22,7 +29,11 @@ from vic_drake.analysis.claims.scans import claim_c4, claim_c5, claim_c6, claim_
 from vic_drake.analysis.claims.thresholds import STATEMENTS
 
 __all__ = [
+    "FAIL",
+    "NOT_EVALUATED",
+    "PASS",
     "Claim",
+    "claim_status",
     "ClaimInputs",
     "ModelResiduals",
     "STATEMENTS",

@@ -6,6 +6,11 @@ claim; the real logs must not contradict it). ``pass_sim`` and
 ``pass_real`` give each side's verdict (None when not evaluated). A side
 that could not be evaluated is ``None`` with the reason in ``detail``; it
 never counts as a pass.
+
+``status`` says which of three a claim is: "pass", "fail" (a side was
+evaluated and contradicts the claim) or "not evaluated" (the simulated side
+could not be evaluated and no evaluated side contradicts the claim; the
+reason is in ``detail``). A claim that was not evaluated is never a "fail".
 """
 
 from collections.abc import Mapping, Sequence
@@ -13,6 +18,18 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+
+#: The three verdicts of a claim (``Claim.status``, "status" in claims.json).
+PASS, FAIL, NOT_EVALUATED = "pass", "fail", "not evaluated"
+
+
+def claim_status(claim: Mapping) -> str:
+    """The status of a claim read from claims.json (older files lack "status")."""
+    if claim.get("status") in (PASS, FAIL, NOT_EVALUATED):
+        return claim["status"]
+    if claim.get("pass_sim") is False or claim.get("pass_real") is False:
+        return FAIL
+    return PASS if claim.get("pass") else NOT_EVALUATED
 
 
 @dataclass(frozen=True)
@@ -43,6 +60,13 @@ class Claim:
     def passed(self) -> bool:
         return bool(self.pass_sim) and self.pass_real is not False
 
+    @property
+    def status(self) -> str:
+        """ "pass", "fail" or "not evaluated" (see the module's docstring)."""
+        if self.pass_sim is False or self.pass_real is False:
+            return FAIL
+        return PASS if self.pass_sim else NOT_EVALUATED
+
     def to_dict(self) -> dict:
         return {
             "statement": self.statement,
@@ -50,6 +74,7 @@ class Claim:
             "sim": self.sim,
             "real": self.real,
             "pass": self.passed,
+            "status": self.status,
             "pass_sim": self.pass_sim,
             "pass_real": self.pass_real,
             "detail": self.detail,

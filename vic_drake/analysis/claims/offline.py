@@ -6,7 +6,6 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import curve_fit
 from scipy.stats import spearmanr
 
 from vic_drake.analysis.claims.claim import Claim, clean, not_evaluated
@@ -24,6 +23,7 @@ from vic_drake.analysis.ribs import (
     RIB_WEAK_FRACTION,
 )
 from vic_drake.errors import VicDrakeError
+from vic_drake.estimation.palpation.residual import fit_exponential
 from vic_drake.paper import BEST_BETA, paper_table_i
 
 
@@ -103,6 +103,10 @@ def claim_c1(
 def residual_decay(duration_s, residual) -> dict:
     """Fits r(T) = c + a exp(-T / tau) to residual vs palpation time.
 
+    The fit is :func:`vic_drake.estimation.palpation.fit_exponential`, the
+    one that Fig. 3 draws, so the figure and claims.json give one number
+    per fitted quantity.
+
     Args:
         duration_s: (n,) palpation lengths, s (n >= 4).
         residual: (n,) residual at each length.
@@ -123,27 +127,15 @@ def residual_decay(duration_s, residual) -> dict:
     order = np.argsort(t)
     t, r = t[order], r[order]
     rho = float(spearmanr(t, r)[0]) if np.ptp(r) > 0 else 0.0
-    span = max(float(np.ptp(t)), 1e-9)
-
-    def model(tt, a, tau, c):
-        return c + a * np.exp(-tt / tau)
-
-    p0 = (max(r[0] - r[-1], 1e-9), span / 3, r[-1])
-    try:
-        (a, tau, c), _ = curve_fit(
-            model,
-            t,
-            r,
-            p0=p0,
-            bounds=([0, 1e-6, -np.inf], [np.inf, 1e3 * span, np.inf]),
-            maxfev=20000,
-        )
-        pred = model(t, a, tau, c)
-        ss_res = float(np.sum((r - pred) ** 2))
+    # The one exponential fit of Fig. 3 (the figure's legend shows the same).
+    fit = fit_exponential(t, r)
+    if fit is None:
+        a, tau, c, r2 = np.nan, np.nan, np.nan, np.nan
+    else:
+        a, tau, c = fit.a, fit.tau_s, fit.c
+        ss_res = float(np.sum((r - fit(t)) ** 2))
         ss_tot = float(np.sum((r - r.mean()) ** 2))
         r2 = 1.0 - ss_res / ss_tot if ss_tot > 0 else 0.0
-    except (RuntimeError, ValueError):
-        a, tau, c, r2 = np.nan, np.nan, np.nan, np.nan
     return {
         "tau_s": float(tau),
         "a": float(a),

@@ -32,6 +32,24 @@ def _need(d: Mapping | None, *keys) -> bool:
     return d is not None and all(d.get(k) is not None for k in keys)
 
 
+def _why_missing(runs: Mapping[str, Mapping | None], keys: Mapping[str, tuple]) -> str:
+    """Why a side cannot be evaluated although its stage ran: which run is
+    absent, or which metric a run lacks (with its scan-window size)."""
+    parts = []
+    for name, need in keys.items():
+        m = runs.get(name)
+        if m is None:
+            parts.append(f"no {name.upper()} scan")
+            continue
+        lacking = [k for k in need if m.get(k) is None]
+        if lacking:
+            parts.append(
+                f"the {name.upper()} scan ran ({m.get('n_window', 0)} samples in its "
+                f"scan window) but gives no {', '.join(lacking)}"
+            )
+    return "; ".join(parts)
+
+
 def _c4_side(vscf: Mapping | None, cf: Mapping | None):
     if not (
         _need(vscf, "force_rmse_N", "lifted_off")
@@ -64,8 +82,13 @@ def claim_c4(
     Args:
         sim, real: {"vs-cf": scan_metrics(...), "cf": scan_metrics(...)}.
     """
+    need = {k: ("force_rmse_N", "lifted_off") for k in ("vs-cf", "cf")}
     sv, sp = _c4_side(*(sim.get(k) for k in ("vs-cf", "cf"))) if sim else (None, None)
     rv, rp = _c4_side(*(real.get(k) for k in ("vs-cf", "cf"))) if real else (None, None)
+    if sim and sv is None:
+        reason_sim = _why_missing(sim, need)
+    if real and rv is None:
+        reason_real = _why_missing(real, need)
     detail = (
         f"RMSE of pressing force vs reference over the scan window; pass: ratio <= "
         f"{C4_MAX_RMSE_RATIO}, VS-CF final force < {CONTACT_THRESHOLD_N} N, CF's not"
@@ -114,8 +137,13 @@ def claim_c5(
     Args:
         sim, real: {"cs": scan_metrics(...), "vs-cf": scan_metrics(...)}.
     """
+    need = {k: ("force_range_N",) for k in ("cs", "vs-cf")}
     sv, sp = _c5_side(*(sim.get(k) for k in ("cs", "vs-cf"))) if sim else (None, None)
     rv, rp = _c5_side(*(real.get(k) for k in ("cs", "vs-cf"))) if real else (None, None)
+    if sim and sv is None:
+        reason_sim = _why_missing(sim, need)
+    if real and rv is None:
+        reason_real = _why_missing(real, need)
     detail = (
         "force range = 98th - 2nd percentile of the pressing force over the scan "
         f"window; pass: ratio >= {C5_MIN_RANGE_RATIO}"
@@ -136,28 +164,59 @@ def claim_c5(
 
 
 def _c6_side(vsvf: Mapping | None):
-    if not _need(
-        vsvf,
-        "penetration_error_off_ribs_median_m",
-        "force_on_ribs_p99_N",
-        "force_cap_N",
-    ):
-        return None, None
+    """(value, verdict, why): each half of C6 judged on its own samples.
+
+    Off the ribs: the median penetration error; over the ribs: the p99 force
+    against the cap. A half that fails makes the side fail; a half with too
+    few samples leaves the side not evaluated, with what happened in the scan.
+    """
+    if vsvf is None:
+        return None, None, None
+    if vsvf.get("n_off_ribs") is None:
+        return (
+            None,
+            None,
+            "the VS-VF log has no force reference, F_min or penetration columns",
+        )
     value = {
         "penetration_off_ribs_median_m": vsvf.get("penetration_off_ribs_median_m"),
-        "penetration_error_off_ribs_median_m": vsvf[
+        "penetration_error_off_ribs_median_m": vsvf.get(
             "penetration_error_off_ribs_median_m"
-        ],
-        "force_on_ribs_p99_N": vsvf["force_on_ribs_p99_N"],
-        "force_cap_N": vsvf["force_cap_N"],
+        ),
+        "force_on_ribs_p99_N": vsvf.get("force_on_ribs_p99_N"),
+        "force_cap_N": vsvf.get("force_cap_N"),
         "n_on_ribs": vsvf.get("n_on_ribs"),
         "n_off_ribs": vsvf.get("n_off_ribs"),
     }
-    ok = (
-        vsvf["penetration_error_off_ribs_median_m"] <= C6_MAX_PEN_ERROR_M
-        and vsvf["force_on_ribs_p99_N"] <= (1 + C6_FORCE_CAP_TOL) * vsvf["force_cap_N"]
-    )
-    return value, bool(ok)
+    halves, why = [], []
+    err = value["penetration_error_off_ribs_median_m"]
+    if err is None:
+        why.append(
+            f"the VS-VF scan has only {value['n_off_ribs']} samples off the ribs "
+            "(force reference below 0.9 |F_min|) in its scan window; needs 10"
+        )
+    else:
+        halves.append(err <= C6_MAX_PEN_ERROR_M)
+    p99, cap = value["force_on_ribs_p99_N"], value["force_cap_N"]
+    if p99 is None or cap is None:
+        why.append(
+            f"over the scan the VS-VF force reference F_body(eps_d) exceeded the cap "
+            f"|F_min| on only {value['n_on_ribs']} samples (needs 10): the probe "
+            "never pressed on a rib hard enough for the cap to bind, so the cap was "
+            "not tested"
+            + (
+                ""
+                if err is None
+                else f" (off the ribs: median |eps - eps_d| = {err * 1e3:.2f} mm)"
+            )
+        )
+    else:
+        halves.append(p99 <= (1 + C6_FORCE_CAP_TOL) * cap)
+    if not all(halves):
+        return value, False, None
+    if why:
+        return value, None, "; ".join(why)
+    return value, True, None
 
 
 def claim_c6(
@@ -178,15 +237,17 @@ def claim_c6(
     |F_min| (the cap binds); "off the ribs" where it is below 0.9 |F_min|.
     """
     eps_d_m = _PAPER_REFERENCE.eps_d_m if eps_d_m is None else eps_d_m
-    sv, sp = _c6_side(sim)
-    rv, rp = _c6_side(real)
+    sv, sp, why_sim = _c6_side(sim)
+    rv, rp, why_real = _c6_side(real)
+    reason_sim = why_sim or reason_sim
+    reason_real = why_real or reason_real
     detail = (
         f"eps_d = {eps_d_m * 1e3:g} mm; pass: median |eps - eps_d| off ribs <= "
         f"{C6_MAX_PEN_ERROR_M * 1e3:g} mm and p99 force on ribs <= "
         f"{1 + C6_FORCE_CAP_TOL:g} x |F_min|"
     )
     extra = not_evaluated(
-        reason_sim if sv is None else None, reason_real if rv is None else None
+        reason_sim if sp is None else None, reason_real if rp is None else None
     )
     return Claim(
         "C6",
@@ -253,8 +314,13 @@ def claim_c7(
             reported in ``detail`` only.
     """
     limits = ScanLimits() if limits is None else limits
+    need = {"vs-vf": ("peak_force_N", "tank_min_J", "tank_power_min_W")}
     sv, sp = _c7_side(sim, limits) if sim else (None, None)
     rv, rp = _c7_side(real, limits) if real else (None, None)
+    if sim and sv is None:
+        reason_sim = _why_missing(sim, need)
+    if real and rv is None and real.get("vs-vf") is not None:
+        reason_real = _why_missing(real, need)
     detail = (
         f"K at min: K_z <= K_min + {C7_K_MIN_TOL_N_PER_M:g} N/m for >= "
         f"{C7_MIN_FRACTION_AT_K_MIN:.0%} of the loss time after {C7_LOSS_SETTLE_S:g} s; "

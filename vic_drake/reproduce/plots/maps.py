@@ -15,6 +15,7 @@ from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 
 from vic_drake.estimation.gp_maps import TissueMap
+from vic_drake.reproduce.plots.figure import new_figure
 
 CMAP = "viridis"  # The paper's Fig. 4 uses MATLAB's parula; viridis is its analogue.
 
@@ -62,7 +63,7 @@ def plot_stiffness_damping_maps(
     title: str | None = None,
 ) -> Figure:
     """Fig. 4: the GP maps of kappa (elasticity) and lambda (viscosity)."""
-    fig = Figure(figsize=(7.0, 6.5))
+    fig = new_figure(figsize=(7.0, 6.5))
     axes = fig.subplots(2, 1)
     beta = tmap.beta
     _panel(
@@ -94,7 +95,7 @@ def plot_std_maps(
     tmap: TissueMap, *, points: bool = True, max_pixels: int = 800, save_path=None
 ) -> Figure:
     """Posterior std of the kappa and lambda GP maps."""
-    fig = Figure(figsize=(7.0, 6.5))
+    fig = new_figure(figsize=(7.0, 6.5))
     axes = fig.subplots(2, 1)
     _panel(
         fig,
@@ -131,7 +132,7 @@ def plot_surface_kappa(
     X, Y = np.meshgrid(100 * x, 100 * y, indexing="ij")
     norm = Normalize(vmin=float(np.min(k)), vmax=float(np.max(k)))
     colors = colormaps[CMAP](norm(k))
-    fig = Figure(figsize=(7.5, 5.5))
+    fig = new_figure(figsize=(7.5, 5.5))
     ax = fig.add_subplot(projection="3d")
     ax.plot_surface(
         X,
@@ -167,7 +168,7 @@ def plot_map_vs_truth(
     save_path=None,
 ) -> Figure:
     """True kappa, the map's kappa, their relative error, and the rib scan line."""
-    fig = Figure(figsize=(11.0, 6.0))
+    fig = new_figure(figsize=(11.0, 6.0))
     axes = fig.subplots(2, 2)
     _panel(fig, axes[0, 0], tmap, truth_kappa, "κ", points=False, max_pixels=max_pixels)
     axes[0, 0].set_title("Phantom κ (truth)")

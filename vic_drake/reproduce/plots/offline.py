@@ -20,6 +20,7 @@ from vic_drake.estimation.palpation import (
     ModelComparison,
     ResidualCurve,
 )
+from vic_drake.reproduce.plots.figure import new_figure
 
 
 def _finish(fig: Figure, save_path) -> Figure:
@@ -58,7 +59,7 @@ def plot_table_i(
     comparisons = _as_mapping(comparisons, "log")
     names = list(comparisons)
     labels = [label for label, _ in _table_rows(comparisons[names[0]])]
-    fig = Figure(figsize=(7.0, 4.0))
+    fig = new_figure(figsize=(7.0, 4.0))
     ax = fig.add_subplot()
     x = np.arange(len(labels))
     width = 0.8 / max(len(names), 1)
@@ -87,7 +88,7 @@ def plot_beta_sweep(
 ) -> Figure:
     """Relative residual against beta, best beta marked, one curve per log."""
     sweeps = _as_mapping(sweeps, "log")
-    fig = Figure(figsize=(6.0, 4.0))
+    fig = new_figure(figsize=(6.0, 4.0))
     ax = fig.add_subplot()
     for name, sweep in sweeps.items():
         (line,) = ax.plot(sweep.betas, sweep.relative, "-o", markersize=3, label=name)
@@ -106,7 +107,7 @@ def plot_load_test(
     result: LoadTestResult, *, title: str | None = None, save_path=None
 ) -> Figure:
     """Fig. 2: measured load-test force against the KV and HC predictions."""
-    fig = Figure(figsize=(7.0, 4.5))
+    fig = new_figure(figsize=(7.0, 4.5))
     ax = fig.add_subplot()
     ax.plot(result.t_s, result.measured_N, color="0.3", lw=1.0, label="measured")
     ax.plot(
@@ -142,7 +143,7 @@ def plot_residual_vs_time(
     """Fig. 3: whole-log relative residual of window fits, with the
     exponential fit a exp(-t/tau) + c."""
     curves = _as_mapping(curves, "log")
-    fig = Figure(figsize=(6.0, 4.0))
+    fig = new_figure(figsize=(6.0, 4.0))
     ax = fig.add_subplot()
     for name, curve in curves.items():
         (line,) = ax.plot(curve.window_s, curve.relative, "o", markersize=3, label=name)
@@ -173,7 +174,7 @@ def plot_lag_profile(
 ) -> Figure:
     """RMS residual (relative to each log's minimum) against candidate lag."""
     profiles = _as_mapping(profiles, "log")
-    fig = Figure(figsize=(6.0, 4.0))
+    fig = new_figure(figsize=(6.0, 4.0))
     ax = fig.add_subplot()
     for name, prof in profiles.items():
         (line,) = ax.plot(1e3 * prof.lags_s, prof.rms_N / prof.rms_N.min(), label=name)
@@ -192,7 +193,7 @@ def plot_palpation_summary(
     comparison: ModelComparison, *, title: str | None = None, save_path=None
 ) -> Figure:
     """Table I bars and, if the comparison holds one, the beta sweep."""
-    fig = Figure(figsize=(11.0, 4.0))
+    fig = new_figure(figsize=(11.0, 4.0))
     ax1, ax2 = fig.subplots(1, 2)
     rows = _table_rows(comparison)
     ax1.bar([r[0] for r in rows], [r[1] for r in rows], color="C0")

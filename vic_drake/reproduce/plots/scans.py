@@ -17,6 +17,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from vic_drake.errors import VicDrakeError
+from vic_drake.reproduce.plots.figure import new_figure
 
 _SIM = {"color": "tab:blue", "lw": 1.2}
 _REAL = {"color": "0.35", "lw": 1.0, "alpha": 0.8}
@@ -45,12 +46,71 @@ def _has(df: pd.DataFrame | None, name: str) -> bool:
     )
 
 
-def _scan_column(axes, sim: pd.DataFrame, real: pd.DataFrame | None, title: str, rows):
+#: Rows that a controller may hold constant, the column each plots, and how
+#: to say so instead of drawing a flat line.
+_MAYBE_FLAT = {
+    "stiffness": ("stiffness_z_N_per_m", "K_z fixed at {v:.4g} N/m"),
+    "tank": ("tank_energy_J", "tank energy fixed at {v:.4g} J (no energy flow)"),
+}
+
+
+def _varies(df: pd.DataFrame | None, name: str) -> bool:
+    """True when the column exists and its finite values are not all one value."""
+    if not _has(df, name):
+        return False
+    v = df[name].to_numpy(float)
+    v = v[np.isfinite(v)]
+    return bool(np.ptp(v) > 1e-9 * max(1.0, float(np.max(np.abs(v)))))
+
+
+def _informative(row: str, sim: pd.DataFrame, real: pd.DataFrame | None) -> bool:
+    """False for a row that would only draw constant lines (e.g. CS's K_z)."""
+    if row not in _MAYBE_FLAT:
+        return True
+    col = _MAYBE_FLAT[row][0]
+    return _varies(sim, col) or _varies(real, col)
+
+
+def _flat_note(ax, row: str, sim: pd.DataFrame, name: str) -> None:
+    """A panel that states the constant instead of drawing a flat line."""
+    col, text = _MAYBE_FLAT[row]
+    if _has(sim, col):
+        v = sim[col].to_numpy(float)
+        note = text.format(v=float(v[np.isfinite(v)][0]))
+    else:
+        note = f"no {col} in this log"
+    ax.set_axis_off()
+    ax.text(
+        0.5, 0.5, f"{name}: {note}", ha="center", va="center", transform=ax.transAxes
+    )
+
+
+def _rows_with_information(rows, sims, reals) -> tuple:
+    """The rows at least one column has information to draw in."""
+    return tuple(
+        r
+        for r in rows
+        if any(_informative(r, df, reals.get(name)) for name, df in sims.items())
+    )
+
+
+def _scan_column(
+    axes,
+    sim: pd.DataFrame,
+    real: pd.DataFrame | None,
+    title: str,
+    rows,
+    name: str = "",
+):
     t = _col(sim, "t_s")
     for ax, row in zip(axes, rows):
+        if not _informative(row, sim, real):
+            _flat_note(ax, row, sim, name.upper())
+            continue
         if row == "force":
             ax.plot(t, -_col(sim, "force_sensor_z_N"), label="F sim", **_SIM)
-            if _has(sim, "force_ref_z_N"):
+            # CS has no force reference (zeros); a cap never below 15 N is off.
+            if _has(sim, "force_ref_z_N") and np.any(_col(sim, "force_ref_z_N") != 0):
                 ax.plot(
                     t,
                     -_col(sim, "force_ref_z_N"),
@@ -59,8 +119,8 @@ def _scan_column(axes, sim: pd.DataFrame, real: pd.DataFrame | None, title: str,
                     lw=1.0,
                     label="F_ref sim",
                 )
-            if _has(sim, "force_min_z_N"):
-                f_min = -_col(sim, "force_min_z_N")
+            f_min = -_col(sim, "force_min_z_N") if _has(sim, "force_min_z_N") else None
+            if f_min is not None and np.any(f_min < 14.9):
                 ax.plot(
                     t,
                     np.where(f_min < 14.9, f_min, np.nan),
@@ -128,6 +188,11 @@ def _scan_column(axes, sim: pd.DataFrame, real: pd.DataFrame | None, title: str,
         ax.legend(fontsize=7, loc="best")
     axes[0].set_title(title)
     axes[-1].set_xlabel("time (s)")
+    if not axes[-1].axison:  # The time axis shows on the last drawn panel.
+        drawn = [ax for ax in axes if ax.axison]
+        if drawn:
+            drawn[-1].set_xlabel("time (s)")
+            drawn[-1].xaxis.set_tick_params(labelbottom=True)
 
 
 def plot_fig6(
@@ -146,12 +211,19 @@ def plot_fig6(
     if not sims:
         raise VicDrakeError("plot_fig6 needs at least one simulated scan")
     reals = reals or {}
-    rows = ("force", "stiffness", "penetration", "tank")
-    fig = Figure(figsize=(5.0 * len(sims), 9.0))
+    rows = _rows_with_information(
+        ("force", "stiffness", "penetration", "tank"), sims, reals
+    )
+    fig = new_figure(figsize=(5.0 * len(sims), 2.25 * len(rows)))
     axes = fig.subplots(len(rows), len(sims), sharex="col", squeeze=False)
     for j, (name, sim) in enumerate(sims.items()):
         _scan_column(
-            axes[:, j], sim, reals.get(name), f"Fig. 6: {name.upper()} nominal", rows
+            axes[:, j],
+            sim,
+            reals.get(name),
+            f"Fig. 6: {name.upper()} nominal",
+            rows,
+            name,
         )
     return _finish(fig, save_path)
 
@@ -172,12 +244,17 @@ def plot_fig7(
     if not sims:
         raise VicDrakeError("plot_fig7 needs at least one simulated scan")
     reals = reals or {}
-    rows = ("force", "height", "stiffness")
-    fig = Figure(figsize=(5.0 * len(sims), 7.0))
+    rows = _rows_with_information(("force", "height", "stiffness"), sims, reals)
+    fig = new_figure(figsize=(5.0 * len(sims), 2.35 * len(rows)))
     axes = fig.subplots(len(rows), len(sims), sharex="col", squeeze=False)
     for j, (name, sim) in enumerate(sims.items()):
         _scan_column(
-            axes[:, j], sim, reals.get(name), f"Fig. 7: {name.upper()} disturbed", rows
+            axes[:, j],
+            sim,
+            reals.get(name),
+            f"Fig. 7: {name.upper()} disturbed",
+            rows,
+            name,
         )
     return _finish(fig, save_path)
 
@@ -189,7 +266,7 @@ def plot_comparison(
     rows = ["force", "height"]
     if _has(real, "stiffness_z_N_per_m"):
         rows.append("stiffness")
-    fig = Figure(figsize=(7.0, 2.4 * len(rows)))
+    fig = new_figure(figsize=(7.0, 2.4 * len(rows)))
     axes = fig.subplots(len(rows), 1, sharex=True, squeeze=False)[:, 0]
     _scan_column(axes, sim, real, title or "simulated vs real", rows)
     return _finish(fig, save_path)

@@ -32,7 +32,7 @@ def gather_claim_inputs(ctx: RunContext) -> claims_mod.ClaimInputs:
     reasons = inp.reasons
 
     def reason(stage: str) -> str:
-        return ctx.stage_error(stage) or "result missing"
+        return ctx.stage_error(stage) or f"the {stage} stage returned no result"
 
     off_real, off_sim = r.get("offline_real"), r.get("offline_sim")
     if off_real:

@@ -3,13 +3,12 @@ with its log (full mode only)."""
 
 from __future__ import annotations
 
-import multiprocessing
 import os
-from concurrent.futures import ProcessPoolExecutor
 
 from vic_drake.reproduce.context import RunContext, StageSkipped
 from vic_drake.reproduce.report import ReportTable
 from vic_drake.reproduce.stages.real_scans import REAL_SCAN_LOGS
+from vic_drake.reproduce.workers import worker_pool
 
 #: Keys of vic_drake.experiments.compare_real shown in the report.
 COMPARE_REAL_KEYS = (
@@ -46,9 +45,7 @@ def stage_compare_real(ctx: RunContext) -> dict:
     names = sorted(set(REAL_SCAN_LOGS.values()))
     workers = max(1, min(len(names), os.cpu_count() or 1))
     out = {}
-    with ProcessPoolExecutor(
-        max_workers=workers, mp_context=multiprocessing.get_context("spawn")
-    ) as pool:
+    with worker_pool(workers) as pool:
         jobs = {
             name: pool.submit(
                 _compare_real_job, (ctx.data_dir / "experiments" / name, ctx.data_dir)

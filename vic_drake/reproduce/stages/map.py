@@ -81,10 +81,16 @@ def stage_map(ctx: RunContext) -> dict:
         "fig4_gp_maps.png",
     )
     ctx.add_figure(
-        "Fig. 4 (comparison): estimated maps and the paper's measured map",
-        "Top: the estimated maps with the detected ribs (red dotted lines); bottom (with "
-        "the paper's data): the paper's own GP map. kappa relative RMS error of the "
-        f"estimate against the phantom: {out['kappa_rel_rmse']:.1%}.",
+        "Fig. 4 (comparison): estimated maps"
+        + (" and the paper's measured map" if real_map is not None else ""),
+        "The estimated maps with the detected ribs (red dotted lines)"
+        + (
+            "; bottom: the paper's own GP map"
+            if real_map is not None
+            else " (no paper's map in this run: the real data is absent)"
+        )
+        + ". kappa relative RMS error of the estimate against the phantom: "
+        f"{out['kappa_rel_rmse']:.1%}.",
         _plot_maps(
             tmap,
             pts,
@@ -108,10 +114,10 @@ def stage_map(ctx: RunContext) -> dict:
 
 def _plot_maps(tmap, pts, real_map, ribs_sim, ribs_real):
     # Function-local: matplotlib is heavy.
-    from matplotlib.figure import Figure
+    from vic_drake.reproduce.plots.figure import new_figure
 
     rows = 2 if real_map is not None else 1
-    fig = Figure(figsize=(11, 3.6 * rows))
+    fig = new_figure(figsize=(11, 3.6 * rows))
     axes = fig.subplots(rows, 2, squeeze=False)
     step = max(1, int(np.ceil(tmap.x_m.size / 400)))
 

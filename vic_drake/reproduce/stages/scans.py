@@ -2,15 +2,15 @@
 
 The four controllers (CS, CF, VS-CF, VS-VF) nominal, and VS-VF, CS, CF with
 the phantom lifted and lowered; every log written as parquet with its
-scenario YAML beside it.
+scenario YAML beside it and as a ROS 2 bag in the real rig's layout
+(``logs/<name>_bag/``).
 """
 
 from __future__ import annotations
 
-import multiprocessing
 import os
 import time
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import as_completed
 from dataclasses import replace
 
 from vic_drake.analysis import claims as claims_mod
@@ -18,6 +18,7 @@ from vic_drake.errors import VicDrakeError
 from vic_drake.paper import CONTROLLERS, DISTURBANCE_CONTROLLERS
 from vic_drake.reproduce.context import RunContext
 from vic_drake.reproduce.report import ReportTable
+from vic_drake.reproduce.workers import worker_pool
 
 #: Quick mode: the target starts QUICK_APPROACH_Z_M high (just above the
 #: surface at the start; see docs/decisions.md, "Quick mode") and scans
@@ -89,6 +90,7 @@ def stage_scans(ctx: RunContext) -> dict:
     """
     # Function-local: pydrake (heavy).
     from vic_drake.experiments import run_scan
+    from vic_drake.experiments.rig_log import check_bag_scenario, write_scan_bag
     from vic_drake.scenario import save_scenario
 
     runs = [("nominal", c) for c in CONTROLLERS] + [
@@ -103,6 +105,8 @@ def stage_scans(ctx: RunContext) -> dict:
         )
         for key in runs
     }
+    for scenario in scenarios.values():  # Before simulating: each log can be a bag.
+        check_bag_scenario(scenario)
     logs = ctx.out_dir / "logs"
     logs.mkdir(parents=True, exist_ok=True)
     local_key = ("nominal", "vs-vf")
@@ -113,9 +117,7 @@ def stage_scans(ctx: RunContext) -> dict:
         f"{local_key[1]} {local_key[0]} in this one"
     )
     results = {}
-    with ProcessPoolExecutor(
-        max_workers=workers, mp_context=multiprocessing.get_context("spawn")
-    ) as pool:
+    with worker_pool(workers) as pool:
         futures = {
             pool.submit(_run_scan_job, (scenarios[k], ctx.data_dir)): k for k in remote
         }
@@ -139,6 +141,8 @@ def stage_scans(ctx: RunContext) -> dict:
         df = result.df
         df.to_parquet(logs / f"{scenario.name}.parquet", index=False)
         save_scenario(scenario, logs / f"{scenario.name}.yaml")
+        # The same log as the real rig's ROS 2 bag (rig_log.write_scan_bag).
+        write_scan_bag(result, logs / f"{scenario.name}_bag")
         lim = scan_limits(scenario)
         limits = limits or lim
         frames[cond][ctrl] = df
@@ -174,13 +178,18 @@ def _scan_figures(ctx: RunContext, frames: dict) -> None:
     from vic_drake.reproduce.plots.scans import plot_fig6, plot_fig7
 
     real = (ctx.results.get("real_scans") or {}).get("frames", {})
+    overlay = (
+        " (grey: the paper's real logs)"
+        if real.get("nominal")
+        else "; no real logs in this run"
+    )
     nominal = {
         k: frames["nominal"][k] for k in ("vs-cf", "vs-vf") if k in frames["nominal"]
     }
     if nominal:
         ctx.add_figure(
             "Fig. 6: VS-CF and VS-VF, nominal",
-            "Simulated scans (and the real logs where they exist): force with "
+            f"Simulated scans on the {ctx.phantom_kind} phantom{overlay}: force with "
             "F_ref and F_min, K_z, penetration, tank energy.",
             plot_fig6(nominal, real.get("nominal")),
             "fig6_nominal.png",
@@ -189,7 +198,9 @@ def _scan_figures(ctx: RunContext, frames: dict) -> None:
     if base:
         ctx.add_figure(
             "CS and CF, nominal (not in the paper's Fig. 6)",
-            "The baselines' nominal scans, same layout as Fig. 6.",
+            f"The baselines' nominal scans on the {ctx.phantom_kind} "
+            f"phantom{overlay}: force and penetration. Their K_z and tank are "
+            "constant (CS: fixed stiffness; CF: no tank) and not drawn.",
             plot_fig6(base, real.get("nominal")),
             "fig6_baselines.png",
         )
@@ -202,7 +213,12 @@ def _scan_figures(ctx: RunContext, frames: dict) -> None:
         ctx.add_figure(
             "Fig. 7: VS-VF, CS, CF with the phantom lifted",
             "Phantom lifted and dropped during the scan: force, tip height with "
-            "the moving surface, K_z (real _dist logs of CS and CF overlaid).",
+            "the moving surface, K_z"
+            + (
+                " (grey: the real _dist logs of CS and CF)."
+                if real.get("disturbance")
+                else "; no real logs in this run."
+            ),
             plot_fig7(dist, real.get("disturbance")),
             "fig7_disturbance.png",
         )

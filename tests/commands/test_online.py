@@ -1,0 +1,77 @@
+"""``vic-drake estimate-online``: the JSON contract on the real logs, and bad input."""
+
+import json
+
+import pytest
+
+from vic_drake.cli import main
+
+KEYS = {
+    "method",
+    "samples",
+    "kappa_rel_err_median",
+    "kappa_corr",
+    "lambda_rel_err_median",
+    "convergence_s",
+    "tick_us_p99",
+}
+
+
+def run(capsys, argv):
+    status = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
+@pytest.mark.parametrize("method", ["rls", "ekf"])
+def test_palpation_json_contract(capsys, data_dir, method):
+    bag = data_dir / "palpation" / "test_soft_25hz"
+    status, out, err = run(
+        capsys, ["estimate-online", bag, "--method", method, "--json"]
+    )
+    assert status == 0, err
+    result = json.loads(out)
+    assert set(result) == KEYS and result["method"] == method
+    assert result["kappa_corr"] is None  # one reference value: no correlation
+    # The issue's targets on a palpation: within 10 % in <= 2 s, and close.
+    assert result["kappa_rel_err_median"] < 0.05
+    assert result["convergence_s"] is not None and result["convergence_s"] <= 2.0
+
+
+def test_scan_log_is_compared_with_the_map(capsys, data_dir):
+    bag = data_dir / "experiments" / "test_nardi_matForce_lowR"
+    status, out, err = run(
+        capsys, ["estimate-online", bag, "--method", "ekf", "--json"]
+    )
+    assert status == 0, err
+    result = json.loads(out)
+    assert set(result) == KEYS and result["samples"] > 10000
+    assert result["kappa_corr"] is not None
+
+
+def test_wrong_layout_and_missing_bag(capsys, data_dir, tmp_path):
+    status, out, err = run(
+        capsys, ["estimate-online", data_dir / "experiments" / "test_force_control"]
+    )
+    assert status == 2 and out == ""
+    assert "'scan' layout (9 columns)" in err and "31 columns" in err
+    status, _, err = run(capsys, ["estimate-online", tmp_path / "nope"])
+    assert status == 2 and "does not exist" in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize(
+    "argv", [["--lag", "-1"], ["--beta", "0"], ["--method", "ukf"]]
+)
+def test_bad_options(capsys, data_dir, argv):
+    bag = data_dir / "palpation" / "test_soft_25hz"
+    with pytest.raises(SystemExit) if argv[0] == "--method" else _no_raise():
+        status, _, err = run(capsys, ["estimate-online", bag, *argv])
+        assert status == 2 and argv[0] in err
+
+
+class _no_raise:
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        return False

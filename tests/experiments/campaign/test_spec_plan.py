@@ -1,0 +1,106 @@
+"""Campaign specs and run plans: checks before any run, deterministic draws."""
+
+from pathlib import Path
+
+import pytest
+
+from vic_drake.errors import VicDrakeError
+from vic_drake.experiments.campaign import load_campaign_spec, plan_campaign
+from vic_drake.experiments.campaign.plan import plan_run
+from vic_drake.scenario import dumps_scenario, load_scenario, loads_scenario
+
+CAMPAIGNS = Path(__file__).resolve().parents[3] / "campaigns"
+BASE = CAMPAIGNS / "base" / "short_scan_synthetic.yaml"
+
+
+def _spec(tmp_path, body: str) -> Path:
+    path = tmp_path / "spec.yaml"
+    path.write_text(f"name: t\nbase_scenario: {BASE}\nruns: 8\nseed: 3\n{body}")
+    return path
+
+
+def _plans(path):
+    spec, base = load_campaign_spec(path)
+    return spec, plan_campaign(spec, load_scenario(base))
+
+
+@pytest.mark.parametrize("name", ["smoke", "breathing", "robustness", "population"])
+def test_shipped_campaigns_plan_every_run(name):
+    spec, plans = _plans(CAMPAIGNS / f"{name}.yaml")
+    assert len(plans) == spec.runs
+    assert len({p.run_id for p in plans}) == spec.runs
+    loads_scenario(dumps_scenario(plans[-1].scenario()))  # What scan replays.
+
+
+def test_grid_cycles_and_draws_depend_only_on_seed_and_index(tmp_path):
+    path = _spec(
+        tmp_path,
+        "factors:\n"
+        "  - {field: controller, dist: grid, labels: [cs, vs-vf]}\n"
+        "  - {field: variations.map_errors.kappa_scale, dist: uniform, low: 0.7, high: 1.3}\n"
+        "  - {field: 'variations.sensor_faults.bias_N[2]', dist: normal, mean: 0, std: 1,"
+        " low: -2, high: 2}\n"
+        "  - {field: variations.sensor_faults.stuck_channel, dist: choice, values: [-1, 2]}\n",
+    )
+    spec, plans = _plans(path)
+    assert [p.factors["controller"] for p in plans] == ["cs", "vs-vf"] * 4
+    again = plan_run(spec, load_scenario(BASE), 5)
+    assert again == plans[5]
+    s = plans[5].scenario()
+    assert s.controller.reference.controller == "vs-vf"
+    assert s.variations.map_errors.kappa_scale == pytest.approx(
+        plans[5].factors["variations.map_errors.kappa_scale"]
+    )
+    assert s.variations.sensor_faults.stuck_channel in (-1, 2)
+    assert s.duration_s == spec.duration_s
+    assert len({p.factors["variations.map_errors.kappa_scale"] for p in plans}) == 8
+
+
+def test_population_draws_a_patient_per_run(tmp_path):
+    _, plans = _plans(_spec(tmp_path, "population: true\n"))
+    s = plans[0].scenario()
+    assert s.variations.patient.enabled
+    assert plans[0].factors["patient.kappa_scale"] == s.variations.patient.kappa_scale
+    assert (
+        plans[0].factors["patient.kappa_scale"]
+        != plans[1].factors["patient.kappa_scale"]
+    )
+
+
+@pytest.mark.parametrize(
+    "body, message",
+    [
+        (
+            "factors:\n  - {field: variations.nope, dist: uniform, low: 0, high: 1}\n",
+            "no field 'nope'",
+        ),
+        ("factors:\n  - {field: controller, dist: choice, labels: [cs, pid]}\n", "pid"),
+        ("factors:\n  - {field: seed, dist: cauchy}\n", "dist must be one of"),
+        ("factors:\n  - {field: seed, dist: uniform, low: 2, high: 1}\n", "low < high"),
+        (
+            "factors:\n  - {field: variations.motion.breathing.amplitude_m, dist: uniform, low: 0, high: 0.5}\n",
+            "amplitude_m",
+        ),
+        (
+            "factors:\n  - {field: controller, dist: grid, labels: [cs, cf, vs-vf]}\n",
+            "multiple of the grid",
+        ),
+        (
+            "factors:\n  - {field: name, dist: uniform, low: 0, high: 1}\n",
+            "takes labels",
+        ),
+        ("runs_: 3\n", "runs_"),
+    ],
+)
+def test_bad_specs_fail_before_any_run(tmp_path, body, message):
+    with pytest.raises(VicDrakeError, match=message):
+        _plans(_spec(tmp_path, body))
+
+
+def test_missing_files_are_named(tmp_path):
+    with pytest.raises(VicDrakeError, match="does not exist"):
+        load_campaign_spec(tmp_path / "none.yaml")
+    path = tmp_path / "s.yaml"
+    path.write_text("name: t\nbase_scenario: nowhere.yaml\n")
+    with pytest.raises(VicDrakeError, match="nowhere.yaml"):
+        load_campaign_spec(path)

@@ -1,0 +1,58 @@
+"""Campaign statistics against closed forms and hand-made rows."""
+
+import math
+
+import pandas as pd
+import pytest
+
+from vic_drake.experiments.campaign.stats import (
+    factor_effects,
+    per_controller,
+    wilson_interval,
+    worst_runs,
+)
+
+
+def test_wilson_interval_closed_form_and_edges():
+    # n = 10, k = 0: upper bound z^2 / (n + z^2).
+    z = 1.959963984540054
+    lo, hi = wilson_interval(0, 10)
+    assert lo == 0.0 and hi == pytest.approx(z * z / (10 + z * z))
+    lo, hi = wilson_interval(10, 10)
+    assert hi == pytest.approx(1.0) and lo == pytest.approx(10 / (10 + z * z))
+    lo, hi = wilson_interval(50, 100)  # Symmetric about 1/2.
+    assert lo + hi == pytest.approx(1.0) and hi - lo == pytest.approx(0.1922, abs=1e-3)
+    assert all(math.isnan(v) for v in wilson_interval(0, 0))
+
+
+def _rows():
+    return pd.DataFrame(
+        {
+            "run_id": [f"run_{i:05d}" for i in range(6)],
+            "index": range(6),
+            "status": ["ok", "ok", "ok", "ok", "nan", "error"],
+            "error": ["", "", "", "", "non-finite", "boom"],
+            "factor.controller": ["cs", "cs", "cs", "vs-vf", "vs-vf", "vs-vf"],
+            "factor.amp": [0.005, 0.010, 0.015, 0.005, 0.010, 0.015],
+            "peak_force_N": [10.0, 16.0, 20.0, 8.0, 9.0, float("nan")],
+            "contact_loss_s": [0.0, 0.1, 0.3, 0.0, 0.0, float("nan")],
+            "tank_min_J": [0.5, 0.5, 0.5, 0.45, 0.41, float("nan")],
+        }
+    )
+
+
+def test_per_controller_counts_scored_runs_only():
+    pc = per_controller(_rows(), force_limit_N=15.0)
+    assert pc["cs"]["runs"] == 3 and pc["cs"]["exceed_prob"] == pytest.approx(2 / 3)
+    assert pc["cs"]["exceed_prob_ci95"] == list(wilson_interval(2, 3))
+    assert pc["vs-vf"]["runs"] == 3 and pc["vs-vf"]["exceed_prob"] == 0.0
+    assert pc["vs-vf"]["tank_min_J"] == 0.41
+    assert pc["cs"]["peak_force_N_p50"] == 16.0 and pc["cs"]["peak_force_N_max"] == 20.0
+
+
+def test_factor_effects_and_worst_runs():
+    effects = factor_effects(_rows())
+    cs = next(e for e in effects if e["controller"] == "cs")
+    assert cs["spearman"] == pytest.approx(1.0)
+    worst = worst_runs(_rows(), n=3)
+    assert list(worst["run_id"]) == ["run_00005", "run_00004", "run_00002"]

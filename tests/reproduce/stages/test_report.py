@@ -1,0 +1,45 @@
+"""The report stage: notes that match the run, versions from the metadata."""
+
+from vic_drake.reproduce import ReproduceOptions, RunContext, StageRecord
+from vic_drake.reproduce.stages.report import package_versions, report_notes
+
+
+def _ctx(tmp_path, monkeypatch, stages):
+    monkeypatch.delenv("VIC_DRAKE_DATA", raising=False)
+    monkeypatch.setattr("vic_drake.paths.DEFAULT_DATA_DIR", tmp_path / "no_data")
+    ctx = RunContext(ReproduceOptions(out_dir=tmp_path / "out", quick=False))
+    ctx.records = [StageRecord(s, True, 1.0) for s in stages]
+    return ctx
+
+
+def test_notes_of_a_run_without_real_data(tmp_path, monkeypatch):
+    ctx = _ctx(tmp_path, monkeypatch, ["offline_sim", "map", "scans"])
+    claims = {
+        "C2": {
+            "sim": {"sim_2.5hz": {"ratio_last_first": 0.97}},
+            "pass_sim": False,
+        }
+    }
+    text = " ".join(report_notes(ctx, claims))
+    assert "This run has no real data" in text
+    for stale in (
+        "real logs test that",
+        "paper's scan logs",
+        "5 cm",
+    ):
+        assert stale not in text, stale
+    assert "0.97 of the shortest one's" in text
+
+
+def test_notes_with_real_logs_and_a_passing_c2(tmp_path, monkeypatch):
+    ctx = _ctx(tmp_path, monkeypatch, ["offline_sim", "offline_real", "real_scans"])
+    claims = {"C2": {"sim": {"ratio_last_first": 0.3}, "pass_sim": True}}
+    text = " ".join(report_notes(ctx, claims))
+    assert "the real logs test that" in text
+    assert "C2 in simulation:" not in text and "C4-C7" not in text
+
+
+def test_versions_from_installed_metadata():
+    v = package_versions()
+    assert v["drake"][0].isdigit() and v["numpy"][0].isdigit()
+    assert "unknown" not in v.values()

@@ -1,0 +1,82 @@
+"""Ctrl-C stops a reproduce run and its worker pool within 2 s, and the
+interrupted run is marked incomplete."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+#: The issue's limit: from SIGINT to the whole process tree gone, s.
+STOP_LIMIT_S = 2.0
+
+
+def _children(pid: int) -> list[int]:
+    kids = []
+    for task in Path(f"/proc/{pid}/task").iterdir():
+        text = (task / "children").read_text().split()
+        kids.extend(int(k) for k in text)
+    return kids
+
+
+def _alive(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().split(")")[-1].split()[0]
+    except FileNotFoundError:
+        return False
+    return state != "Z"
+
+
+def test_sigint_stops_the_scan_workers_within_2_s(tmp_path):
+    out = tmp_path / "run"
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "vic_drake.cli",
+            "reproduce",
+            "--quick",
+            "--phantom",
+            "synthetic",
+            "--stages",
+            "scans",
+            "--out",
+            str(out),
+        ],
+        stderr=subprocess.PIPE,
+        stdout=subprocess.DEVNULL,
+        text=True,
+        env={**os.environ, "PYTHONUNBUFFERED": "1"},
+    )
+    try:
+        for line in proc.stderr:
+            if "worker process(es)" in line:
+                break
+        else:
+            raise AssertionError("the scans stage never started")
+        # Let the workers spawn and start their scans.
+        deadline = time.monotonic() + 60
+        while len(_children(proc.pid)) < 1 and time.monotonic() < deadline:
+            time.sleep(0.2)
+        time.sleep(4.0)
+        workers = _children(proc.pid)
+        assert workers, "no worker process started"
+        t0 = time.monotonic()
+        proc.send_signal(signal.SIGINT)
+        rc = proc.wait(timeout=30)
+        stopped = time.monotonic() - t0
+        while any(_alive(w) for w in workers) and time.monotonic() - t0 < 30:
+            time.sleep(0.05)
+        all_gone = time.monotonic() - t0
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert rc == 130
+    assert stopped <= STOP_LIMIT_S, f"main process took {stopped:.2f} s"
+    assert all_gone <= STOP_LIMIT_S, f"workers took {all_gone:.2f} s"
+    # Nothing at --out; the partial run is marked incomplete beside it.
+    assert not out.exists()
+    marker = json.loads((tmp_path / ".run.partial" / "run.json").read_text())
+    assert marker["complete"] is False

@@ -1,0 +1,95 @@
+"""The controller with ``stiffness_source="online"``: the references use the
+estimator's kappa (seeded with the prior), not the map; bad options fail."""
+
+import numpy as np
+import pytest
+
+from vic_drake.control.params import (
+    ControllerParams,
+    ReferenceParams,
+    StiffnessQpParams,
+)
+from vic_drake.errors import VicDrakeError
+from vic_drake.estimation.online import OnlineEstimatorParams
+from vic_drake.scenario import Scenario
+from vic_drake.systems.controller import MakeVariableImpedanceController
+from vic_drake.tissue.phantom import GridPhantom
+
+EPS_D, BETA = 0.008, 1.35
+
+
+def _params():
+    return ControllerParams(
+        qp=StiffnessQpParams(solver="exact"),
+        reference=ReferenceParams(controller="vs-vf", eps_d_m=EPS_D),
+    )
+
+
+def _phantom(kappa):
+    ones = np.ones((2, 2))
+    x = np.array([-1.0, 1.0])
+    return GridPhantom(
+        x_m=x, y_m=x, z_m=0.1 * ones, kappa=kappa * ones, lam=8 * kappa * ones
+    )
+
+
+def _run_ticks(diagram, n, z=0.094, force_z=-6.0):
+    context = diagram.CreateDefaultContext()
+    for name, value in (("probe.position", [0.0, -0.36, z]), ("probe.velocity", [0.0, 0.0, 0.0]),
+                        ("target_position", [0.0, -0.36, 0.085]),
+                        ("ft_sensor.force_W", [0.0, 0.0, force_z])):  # fmt: skip
+        diagram.GetInputPort(name).FixValue(context, value)
+    for k in range(n):
+        context.SetTime(k * 0.002)
+        context.SetDiscreteState(diagram.EvalUniquePeriodicDiscreteUpdate(context))
+    return context
+
+
+@pytest.mark.parametrize("surface", ["estimated", "map"])
+def test_online_references_follow_the_estimate_not_the_map(surface):
+    prior = OnlineEstimatorParams(method="ekf", kappa_prior=3000.0, lam_prior=24000.0)
+    # The map says 9000: with "online" only its surface may be read.
+    diagram = MakeVariableImpedanceController(
+        _params(),
+        phantom=_phantom(9000.0),
+        stiffness_source="online",
+        estimator=prior,
+        online_surface=surface,
+    )
+    context = _run_ticks(diagram, 1)
+    est = diagram.GetOutputPort("tissue_estimate").Eval(context)
+    f_ref = diagram.GetOutputPort("force_reference").Eval(context)[2]
+    # The first tick's reference used the prior (the estimate is from state).
+    assert f_ref == pytest.approx(-3000.0 * EPS_D**BETA, rel=1e-9)
+    context = _run_ticks(diagram, 200)
+    est = diagram.GetOutputPort("tissue_estimate").Eval(context)
+    f_ref = diagram.GetOutputPort("force_reference").Eval(context)[2]
+    assert np.all(np.isfinite(est[:5]))
+    assert f_ref == pytest.approx(-est[0] * EPS_D**BETA, rel=1e-6)
+    if surface == "map":  # 6 mm deep in a flat surface at 0.1 m, 6 N.
+        assert est[0] == pytest.approx(6.0 / 0.006**BETA, rel=0.02)
+
+
+def test_online_needs_estimator_params():
+    with pytest.raises(VicDrakeError, match="estimator"):
+        MakeVariableImpedanceController(
+            _params(), phantom=None, stiffness_source="online"
+        )
+    with pytest.raises(VicDrakeError, match="online_surface"):
+        MakeVariableImpedanceController(
+            _params(),
+            phantom=None,
+            stiffness_source="online",
+            estimator=OnlineEstimatorParams(),
+            online_surface="guess",
+        )
+
+
+@pytest.mark.parametrize(
+    "field, value", [("stiffness_source", "prior"), ("online_surface", "none")]
+)
+def test_scenario_validates_the_source(field, value):
+    s = Scenario()
+    setattr(s, field, value)
+    with pytest.raises(VicDrakeError, match=field):
+        s.validate()

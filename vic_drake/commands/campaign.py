@@ -1,0 +1,122 @@
+"""``vic-drake campaign SPEC.yaml --out DIR``: a safety campaign on Dask.
+
+Runs every run of a campaign spec (``campaigns/*.yaml``) on a local Dask
+cluster (``--workers N`` processes, default: the machine's cores) or on an
+existing one (``--scheduler tcp://host:port``), writes one row per run as it
+finishes, and the summary (``summary.html``, ``summary.json``,
+``results.parquet``). ``--resume`` finishes an interrupted campaign.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from vic_drake.commands.common import Progress, add_json_option, emit
+from vic_drake.errors import VicDrakeError
+
+#: The keys --json prints (the command's contract), in order.
+JSON_KEYS = (
+    "runs",
+    "finished",
+    "failed",
+    "nan_runs",
+    "wall_s",
+    "runs_per_hour",
+    "workers",
+    "per_controller",
+)
+
+#: The keys of each controller's entry.
+CONTROLLER_KEYS = (
+    "runs",
+    "peak_force_N_p50",
+    "peak_force_N_max",
+    "exceed_prob",
+    "exceed_prob_ci95",
+    "contact_loss_s_p50",
+    "tank_min_J",
+)
+
+
+def _workers(text: str) -> int:
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"takes an integer >= 1; got {text!r}"
+        ) from None
+    if n < 1:
+        raise argparse.ArgumentTypeError(f"takes an integer >= 1; got {text!r}")
+    return n
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser(
+        "campaign",
+        help="run a safety campaign (many scans with sampled variations) on Dask",
+        description=__doc__.split("\n\n", 1)[1],
+    )
+    p.add_argument(
+        "spec", metavar="SPEC.yaml", help="the campaign spec (campaigns/*.yaml)"
+    )
+    p.add_argument("--out", required=True, metavar="DIR", help="output folder")
+    where = p.add_mutually_exclusive_group()
+    where.add_argument(
+        "--workers",
+        type=_workers,
+        default=None,
+        metavar="N",
+        help="local Dask worker processes (default: the machine's cores)",
+    )
+    where.add_argument(
+        "--scheduler",
+        default=None,
+        metavar="ADDRESS",
+        help="an existing Dask scheduler, e.g. tcp://10.0.0.5:8786",
+    )
+    p.add_argument(
+        "--resume", action="store_true", help="finish the campaign already in --out"
+    )
+    add_json_option(p)
+    p.set_defaults(handler=run_campaign_command)
+
+
+def _human(result: dict) -> str:
+    lines = [
+        f"{result['finished']}/{result['runs']} runs finished, {result['failed']} failed "
+        f"({result['nan_runs']} NaN), {result['wall_s']:.0f} s on {result['workers']} "
+        f"workers, {result['runs_per_hour']:.0f} runs/h",
+        f"{'controller':<10} {'runs':>5} {'peakF p50':>10} {'peakF max':>10} "
+        f"{'P(exceed)':>10} {'95% CI':>16} {'loss p50 s':>10} {'tank min J':>10}",
+    ]
+    for name, v in result["per_controller"].items():
+        lo, hi = v["exceed_prob_ci95"]
+        lines.append(
+            f"{name:<10} {v['runs']:>5} {v['peak_force_N_p50']:>10.2f} "
+            f"{v['peak_force_N_max']:>10.2f} {v['exceed_prob']:>10.3f} "
+            f"{f'[{lo:.3f}, {hi:.3f}]':>16} {v['contact_loss_s_p50']:>10.3f} "
+            f"{v['tank_min_J']:>10.3f}"
+        )
+    return "\n".join(lines)
+
+
+def run_campaign_command(args: argparse.Namespace) -> int:
+    from vic_drake.experiments.campaign import run_campaign
+
+    if args.scheduler is not None and not args.scheduler.strip():
+        raise VicDrakeError("--scheduler needs an address such as tcp://host:8786")
+    result = run_campaign(
+        args.spec,
+        args.out,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        resume=args.resume,
+        progress=Progress(True),
+    )
+    out = {key: result[key] for key in JSON_KEYS}
+    out["per_controller"] = {
+        name: {key: v[key] for key in CONTROLLER_KEYS}
+        for name, v in result["per_controller"].items()
+    }
+    emit(out, args.json, _human(out))
+    return 0 if out["failed"] == 0 else 1

@@ -1,0 +1,132 @@
+"""``vic-drake estimate-online BAG``: an online estimator replayed over a real log.
+
+Runs the recursive least squares or the EKF tick by tick over a palpation
+log (6 columns; reference: the offline least-squares Hunt-Crossley fit of
+the whole log) or a variable-impedance scan log (31 columns; reference: the
+measured GP map's kappa and lambda at the probe's (x, y)), and prints the
+median relative errors, the correlation of kappa with the reference, the
+convergence time and the tick cost.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+
+from vic_drake.commands.common import (
+    Progress,
+    add_data_dir_option,
+    add_json_option,
+    emit,
+)
+from vic_drake.errors import DataNotFoundError, VicDrakeError
+from vic_drake.paths import resolve_data_dir
+
+
+def _estimate_online(args: argparse.Namespace) -> int:
+    from vic_drake.estimation.online import OnlineEstimatorParams
+    from vic_drake.experiments.online_replay import replay_online
+
+    if args.lag is not None and not (
+        math.isfinite(args.lag) and 0.0 <= args.lag <= 1.0
+    ):
+        raise VicDrakeError(f"--lag must be in [0, 1] s; got {args.lag!r}")
+    if not (math.isfinite(args.beta) and 0.0 < args.beta <= 3.0):
+        raise VicDrakeError(f"--beta must be in (0, 3]; got {args.beta!r}")
+    path = Path(args.bag_dir).expanduser()
+    if not path.exists() and not path.is_absolute():
+        path = resolve_data_dir(args.data_dir) / path
+    if not path.exists():
+        raise DataNotFoundError(
+            f"bag {args.bag_dir!r} does not exist; expected a ROS 2 bag folder "
+            "(metadata.yaml + .db3) of the 6-column palpation or the 31-column "
+            "variable-impedance layout"
+        )
+    say = Progress()
+    say(f"replaying {args.bag_dir} through the {args.method.upper()} estimator")
+    if args.surface_walk is not None and args.method != "ekf":
+        raise VicDrakeError(
+            "--surface-walk needs --method ekf (the RLS trusts the surface)"
+        )
+    walk = 0.0 if args.surface_walk is None else args.surface_walk
+    if not (math.isfinite(walk) and 0.0 <= walk <= 0.1):
+        raise VicDrakeError(
+            f"--surface-walk must be in [0, 0.1] m/sqrt(s); got {walk!r}"
+        )
+    params = OnlineEstimatorParams(
+        method=args.method, beta=args.beta, surface_walk_m_per_sqrt_s=walk
+    )
+    result = replay_online(path, params=params, lag_s=args.lag, data_dir=args.data_dir)
+    s = result.summary
+    ref = (
+        "offline least-squares fit of the whole log"
+        if result.kind == "palpation"
+        else "measured GP map at the probe's (x, y)"
+    )
+
+    def fmt(v, spec):
+        return "n/a" if v is None or not math.isfinite(v) else format(v, spec)
+
+    human = "\n".join(
+        [
+            f"{result.kind} {args.bag_dir}: {s['samples']} samples, method {s['method']}, "
+            f"force paired with the position {result.lag_s * 1e3:.1f} ms earlier",
+            f"reference: {ref}",
+            f"kappa: median relative error {fmt(s['kappa_rel_err_median'], '.3f')}, "
+            f"correlation {fmt(s['kappa_corr'], '.3f')}, at the last contact sample "
+            f"{fmt(result.final_kappa_rel_err, '.3f')}",
+            f"lambda: median relative error {fmt(s['lambda_rel_err_median'], '.3f')}",
+            f"convergence (kappa stays within 10 %): {fmt(s['convergence_s'], '.2f')} s "
+            "after first contact",
+            f"tick cost p99 {s['tick_us_p99']:.1f} us (as a function)",
+        ]
+    )
+    emit(s, args.json, human)
+    return 0
+
+
+def register(subparsers) -> None:
+    """Adds ``estimate-online``."""
+    p = subparsers.add_parser(
+        "estimate-online",
+        help="replay an online kappa/lambda estimator over a real log",
+        description=__doc__.split("\n\n")[1],
+    )
+    p.add_argument(
+        "bag_dir",
+        metavar="BAG",
+        help="bag folder: 6-column palpation or 31-column VS scan (absolute, "
+        "relative, or relative to the data folder)",
+    )
+    p.add_argument(
+        "--method",
+        choices=("rls", "ekf"),
+        default="rls",
+        help="recursive least squares with forgetting, or the EKF (default %(default)s)",
+    )
+    p.add_argument(
+        "--lag",
+        type=float,
+        default=None,
+        metavar="S",
+        help="force-after-position delay, s (default: the offline estimate on a "
+        "palpation, 0 on a scan)",
+    )
+    p.add_argument(
+        "--beta",
+        type=float,
+        default=1.35,
+        help="Hunt-Crossley exponent, in (0, 3] (default %(default)s)",
+    )
+    p.add_argument(
+        "--surface-walk",
+        type=float,
+        default=None,
+        metavar="M",
+        help="EKF only: estimate a surface offset too, with this random walk in "
+        "m/sqrt(s) (default: trust the surface of the log or map)",
+    )
+    add_data_dir_option(p)
+    add_json_option(p)
+    p.set_defaults(handler=_estimate_online)

@@ -1,0 +1,241 @@
+"""What the RLS and the EKF share: the state layout, the contact and surface
+bookkeeping of one sample, and the scalar Kalman update.
+
+The estimator state is one flat list of floats (it lives in a LeafSystem's
+discrete state as is): :data:`AUX_SIZE` bookkeeping entries, then the
+parameter vector x (n, normalised: kappa / kappa_prior, lam / lam_prior,
+the surface offset in mm, beta), then its covariance P (n * n, row-major).
+
+Per sample (:func:`prepare`):
+
+- a non-finite time, position, velocity or force, or a time that does not
+  increase, is a fault: nothing changes but the fault count;
+- the surface is the input's when finite; otherwise it is latched at first
+  contact at the height where the current estimate gives the measured force
+  (``z + (F / kappa_hat)^(1 / beta)``) and released when the force drops
+  below the contact threshold (the next contact latches anew);
+- the surface rate s_dot is a first-order low-pass of its finite
+  differences, restarted after a gap longer than ``max_gap_s``;
+- contact: force above ``contact_threshold_N`` and penetration above
+  ``min_penetration_m``; only samples in contact update x.
+
+All arithmetic is on Python floats: the filters are 2 to 4 states, where
+numpy's per-call overhead would dominate a tick.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+from vic_drake.estimation.online.params import OnlineEstimatorParams
+
+# Bookkeeping entries at the head of the state.
+T_PREV = 0  # time of the last good sample, s (NaN before the first)
+S_LATCH = 1  # latched surface height, m (NaN: none)
+S_PREV = 2  # surface used at the last good sample, m (NaN: none)
+S_DOT = 3  # filtered surface rate, m/s
+IN_CONTACT = 4  # 1 if the last good sample was in contact
+N_UPDATES = 5  # samples that updated x
+N_FAULTS = 6  # non-finite or out-of-order samples
+N_CLIPPED = 7  # updates whose innovation was clipped (spikes, big changes)
+T_UPDATE = 8  # time of the last update, s (NaN before the first)
+AUX_SIZE = 9
+
+#: Fields of the estimator's outputs, in order (:class:`Estimate`).
+OUTPUT_FIELDS = (
+    "kappa_hat",
+    "lambda_hat",
+    "kappa_var",
+    "lambda_var",
+    "valid",
+    "surface_z_m",
+    "in_contact",
+)
+
+
+class Estimate(NamedTuple):
+    """One sample's outputs.
+
+    Attributes:
+        kappa_hat: N/m^beta. lambda_hat: N s/m^(beta+1).
+        kappa_var, lambda_var: their variances (same units squared).
+        valid: 1.0 when in contact and kappa's std is below
+            ``valid_rel_std`` of kappa_hat, else 0.0.
+        surface_z_m: the surface height the sample used (NaN if none).
+        in_contact: 1.0 when the sample was in contact (it updated the
+            estimate), else 0.0.
+    """
+
+    kappa_hat: float
+    lambda_hat: float
+    kappa_var: float
+    lambda_var: float
+    valid: float
+    surface_z_m: float
+    in_contact: float
+
+
+class Sample(NamedTuple):
+    """A prepared sample: None from :func:`prepare` on a fault."""
+
+    dt: float  # since the last good sample, s (0 for the first)
+    s: float  # surface height, m (NaN if unknown)
+    s_dot: float  # surface rate, m/s
+    contact: bool  # force above threshold (the surface test is the filter's)
+
+
+def initial_state(x0: list[float], p0_diag: list[float]) -> list[float]:
+    """A fresh state: no sample seen, x = x0, P = diag(p0_diag)."""
+    n = len(x0)
+    aux = [math.nan, math.nan, math.nan, 0.0, 0.0, 0.0, 0.0, 0.0, math.nan]
+    P = [0.0] * (n * n)
+    for i in range(n):
+        P[i * n + i] = float(p0_diag[i])
+    return aux + [float(v) for v in x0] + P
+
+
+def unpack(state, n: int) -> tuple[list[float], list[float], list[float]]:
+    """(aux, x, P) as new lists."""
+    state = list(state)
+    return state[:AUX_SIZE], state[AUX_SIZE : AUX_SIZE + n], state[AUX_SIZE + n :]
+
+
+def prepare(
+    aux: list[float],
+    t: float,
+    z: float,
+    z_dot: float,
+    force: float,
+    surface_z: float,
+    kappa_hat: float,
+    beta: float,
+    p: OnlineEstimatorParams,
+) -> Sample | None:
+    """Bookkeeping of one sample (updates ``aux`` in place); None on a fault."""
+    if not math.isfinite(t + z + z_dot + force) or not (
+        math.isnan(aux[T_PREV]) or t > aux[T_PREV]
+    ):
+        aux[N_FAULTS] += 1.0
+        return None
+    dt = 0.0 if math.isnan(aux[T_PREV]) else t - aux[T_PREV]
+    aux[T_PREV] = t
+    contact = force > p.contact_threshold_N
+    if math.isfinite(surface_z):
+        s = surface_z
+    else:
+        if not contact:
+            aux[S_LATCH] = math.nan
+        elif math.isnan(aux[S_LATCH]):
+            aux[S_LATCH] = z + (force / kappa_hat) ** (1.0 / beta)
+        s = aux[S_LATCH]
+    s_prev = aux[S_PREV]
+    if math.isfinite(s) and math.isfinite(s_prev) and 0.0 < dt <= p.max_gap_s:
+        alpha = dt / (p.surface_rate_time_constant_s + dt)
+        aux[S_DOT] += alpha * ((s - s_prev) / dt - aux[S_DOT])
+    else:
+        aux[S_DOT] = 0.0
+    aux[S_PREV] = s
+    return Sample(dt, s, aux[S_DOT], contact)
+
+
+def scalar_update(
+    x: list[float],
+    P: list[float],
+    h: list[float],
+    innovation: float,
+    r: float,
+    gate_sigma: float,
+) -> bool:
+    """Kalman update with one scalar measurement, in place; True if clipped.
+
+    The innovation is clipped at ``gate_sigma`` predicted standard
+    deviations (Huber-like): a spike moves x by a bounded step.
+    """
+    n = len(x)
+    if n == 2:  # The RLS and the plain EKF: unrolled (a third of the cost).
+        p00, p01, p11 = P[0], P[1], P[3]
+        a = p00 * h[0] + p01 * h[1]
+        b = p01 * h[0] + p11 * h[1]
+        s = h[0] * a + h[1] * b + r
+        bound = gate_sigma * math.sqrt(s)
+        clipped = abs(innovation) > bound
+        if clipped:
+            innovation = math.copysign(bound, innovation)
+        x[0] += a / s * innovation
+        x[1] += b / s * innovation
+        P[0] = p00 - a * a / s
+        P[1] = P[2] = p01 - a * b / s
+        P[3] = p11 - b * b / s
+        return clipped
+    Ph = [sum(P[i * n + j] * h[j] for j in range(n)) for i in range(n)]
+    s = sum(h[i] * Ph[i] for i in range(n)) + r
+    bound = gate_sigma * math.sqrt(s)
+    clipped = abs(innovation) > bound
+    if clipped:
+        innovation = math.copysign(bound, innovation)
+    for i in range(n):
+        x[i] += Ph[i] / s * innovation
+    for i in range(n):
+        for j in range(n):
+            P[i * n + j] -= Ph[i] * Ph[j] / s
+    return clipped
+
+
+def cap_variances(P: list[float], caps: list[float]) -> None:
+    """Scales row and column i so that P_ii <= caps[i] (keeps P PSD), in place."""
+    n = len(caps)
+    for i in range(n):
+        pii = P[i * n + i]
+        if pii > caps[i]:
+            f = math.sqrt(caps[i] / pii)
+            for j in range(n):
+                P[i * n + j] *= f
+                P[j * n + i] *= f
+
+
+def bound_parameters(x: list[float], max_rel_change: float) -> None:
+    """Keeps the normalised kappa and lam (x[0], x[1]) in [1/m, m], in place."""
+    lo = 1.0 / max_rel_change
+    for i in (0, 1):
+        x[i] = min(max(x[i], lo), max_rel_change)
+
+
+def make_estimate(
+    aux: list[float],
+    x: list[float],
+    P: list[float],
+    p: OnlineEstimatorParams,
+    surface: float,
+    in_contact: bool,
+) -> Estimate:
+    """The outputs of a state (kappa and lam de-normalised)."""
+    n = len(x)
+    kappa = x[0] * p.kappa_prior
+    kappa_var = P[0] * p.kappa_prior**2
+    lam_var = P[n + 1] * p.lam_prior**2
+    valid = in_contact and math.sqrt(max(kappa_var, 0.0)) < p.valid_rel_std * kappa
+    return Estimate(
+        kappa,
+        x[1] * p.lam_prior,
+        kappa_var,
+        lam_var,
+        1.0 if valid else 0.0,
+        surface,
+        1.0 if in_contact else 0.0,
+    )
+
+
+__all__ = [
+    "AUX_SIZE",
+    "OUTPUT_FIELDS",
+    "Estimate",
+    "Sample",
+    "bound_parameters",
+    "cap_variances",
+    "initial_state",
+    "make_estimate",
+    "prepare",
+    "scalar_update",
+    "unpack",
+]

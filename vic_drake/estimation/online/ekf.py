@@ -1,0 +1,141 @@
+"""Extended Kalman filter on Hunt-Crossley kappa, lam (and the surface, beta).
+
+The state is a random walk (the tissue under a moving probe changes; the
+follow-up work of the paper's first author used EKF/UKF variants on
+Hunt-Crossley at fixed beta):
+
+    x = [kappa / kappa_prior, lam / lam_prior, (ds in mm), (beta)]
+
+with the surface offset ds (in the state when ``surface_walk_m_per_sqrt_s``
+> 0: the surface is then s_in + ds, so a map's offset, or the drift of a
+surface latched at first contact, is estimated too) and beta (when
+``estimate_beta``). Measurement: the tissue force
+
+    F = (kappa + lam eps_dot) (s_in + ds - z)^beta
+
+linearised at the current state. Prediction adds the random-walk variance
+of the time since the last update (a contact loss of a few seconds lets
+the estimate move again at re-contact), capped at the prior variance.
+Faulty samples and samples out of contact change nothing.
+"""
+
+from __future__ import annotations
+
+import math
+
+from vic_drake.estimation.online.core import (
+    IN_CONTACT,
+    N_CLIPPED,
+    N_UPDATES,
+    S_PREV,
+    T_UPDATE,
+    Estimate,
+    bound_parameters,
+    initial_state,
+    make_estimate,
+    prepare,
+    scalar_update,
+    unpack,
+)
+from vic_drake.estimation.online.params import OnlineEstimatorParams
+
+_MM = 1e-3
+
+
+def ekf_layout(params: OnlineEstimatorParams) -> tuple[int, int | None, int | None]:
+    """(state size, index of the surface offset or None, index of beta or None)."""
+    n = 2
+    i_s = i_b = None
+    if params.surface_walk_m_per_sqrt_s > 0.0:
+        i_s, n = n, n + 1
+    if params.estimate_beta:
+        i_b, n = n, n + 1
+    return n, i_s, i_b
+
+
+def _prior(params: OnlineEstimatorParams) -> tuple[list[float], list[float]]:
+    n, i_s, i_b = ekf_layout(params)
+    x0 = [1.0, 1.0] + [0.0] * (n - 2)
+    v = [params.prior_rel_std**2] * 2 + [0.0] * (n - 2)
+    if i_s is not None:
+        v[i_s] = (params.surface_prior_std_m / _MM) ** 2
+    if i_b is not None:
+        x0[i_b] = params.beta
+        v[i_b] = params.beta_prior_std**2
+    return x0, v
+
+
+def ekf_initial_state(params: OnlineEstimatorParams) -> list[float]:
+    """State at the prior (see the module docstring for the layout)."""
+    x0, v = _prior(params)
+    return initial_state(x0, v)
+
+
+def _walk(params: OnlineEstimatorParams, n, i_s, i_b) -> list[float]:
+    """Random-walk variance per second of each state."""
+    q = [
+        params.kappa_walk_rel_per_sqrt_s**2,
+        params.lam_walk_rel_per_sqrt_s**2,
+    ] + [0.0] * (n - 2)
+    if i_s is not None:
+        q[i_s] = (params.surface_walk_m_per_sqrt_s / _MM) ** 2
+    if i_b is not None:
+        q[i_b] = params.beta_walk_per_sqrt_s**2
+    return q
+
+
+def ekf_step(
+    state,
+    t: float,
+    z: float,
+    z_dot: float,
+    force: float,
+    surface_z: float,
+    params: OnlineEstimatorParams,
+) -> tuple[list[float], Estimate]:
+    """One sample; arguments and result as :func:`~vic_drake.estimation.online.rls.rls_step`.
+
+    ``surface_z_m`` of the estimate is the corrected surface s_in + ds.
+    """
+    p = params
+    n, i_s, i_b = ekf_layout(p)
+    aux, x, P = unpack(state, n)
+    beta = x[i_b] if i_b is not None else p.beta
+    sample = prepare(aux, t, z, z_dot, force, surface_z, x[0] * p.kappa_prior, beta, p)
+    ds = x[i_s] * _MM if i_s is not None else 0.0
+    if sample is None:
+        aux[IN_CONTACT] = 0.0
+        return aux + x + P, make_estimate(aux, x, P, p, aux[S_PREV] + ds, False)
+    surface = sample.s + ds
+    eps = surface - z
+    contact = sample.contact and eps > p.min_penetration_m
+    if contact:
+        if not math.isnan(aux[T_UPDATE]):
+            elapsed = t - aux[T_UPDATE]
+            _, v0 = _prior(p)
+            for i, q in enumerate(_walk(p, n, i_s, i_b)):
+                P[i * n + i] = min(P[i * n + i] + q * elapsed, max(v0[i], P[i * n + i]))
+        kappa, lam = x[0] * p.kappa_prior, x[1] * p.lam_prior
+        eps_dot = sample.s_dot - z_dot
+        e_b = eps**beta
+        stiff = kappa + lam * eps_dot
+        predicted = stiff * e_b
+        h = [p.kappa_prior * e_b, p.lam_prior * e_b * eps_dot] + [0.0] * (n - 2)
+        if i_s is not None:
+            h[i_s] = stiff * beta * eps ** (beta - 1.0) * _MM
+        if i_b is not None:
+            h[i_b] = predicted * math.log(eps)
+        if scalar_update(x, P, h, force - predicted, p.noise_std_N**2, p.gate_sigma):
+            aux[N_CLIPPED] += 1.0
+        bound_parameters(x, p.max_rel_change)
+        if i_b is not None:
+            x[i_b] = min(max(x[i_b], 0.5), 3.0)
+        if i_s is not None:
+            surface = sample.s + x[i_s] * _MM
+        aux[N_UPDATES] += 1.0
+        aux[T_UPDATE] = t
+    aux[IN_CONTACT] = 1.0 if contact else 0.0
+    return aux + x + P, make_estimate(aux, x, P, p, surface, contact)
+
+
+__all__ = ["ekf_initial_state", "ekf_layout", "ekf_step"]

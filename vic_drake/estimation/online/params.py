@@ -1,0 +1,151 @@
+"""Settings of the online tissue estimators (RLS and EKF on Hunt-Crossley).
+
+One dataclass for both estimators, so a scenario can switch ``method``
+without rewriting the rest. Mutable with a :meth:`validate`, as every config
+that ``yaml_load_typed`` fills (no ``from __future__ import annotations``:
+the loader reads the field types at run time).
+"""
+
+import math
+from dataclasses import dataclass
+
+from vic_drake.errors import VicDrakeError
+from vic_drake.paper import BEST_BETA, CONTACT_THRESHOLD_N
+
+#: The online estimators, by name.
+ONLINE_METHODS = ("rls", "ekf")
+
+
+def _number(name: str, value, *, low=None, low_open=False, high=None) -> float:
+    o = "OnlineEstimatorParams"
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise VicDrakeError(f"{o}.{name} must be a number; got {value!r}") from None
+    if isinstance(value, bool) or not math.isfinite(v):
+        raise VicDrakeError(f"{o}.{name} must be a finite number; got {value!r}")
+    if low is not None and (v < low or (low_open and v == low)):
+        sign = ">" if low_open else ">="
+        raise VicDrakeError(f"{o}.{name} must be {sign} {low}; got {value!r}")
+    if high is not None and v > high:
+        raise VicDrakeError(f"{o}.{name} must be <= {high}; got {value!r}")
+    return v
+
+
+@dataclass
+class OnlineEstimatorParams:
+    """How the online estimator weighs the prior, the data and the faults.
+
+    Measurement model (the tissue force on the probe, positive = the body
+    pushes the probe up; paper eq. 2):
+    ``F = (kappa + lam eps_dot) eps^beta``, ``eps = s - z``,
+    ``eps_dot = s_dot - z_dot``.
+
+    Attributes:
+        method: "rls" (recursive least squares with exponential forgetting
+            on kappa, lam at fixed beta) or "ekf" (extended Kalman filter
+            with kappa, lam, a surface offset and optionally beta as a
+            random walk).
+        beta: Hunt-Crossley exponent (fixed; the EKF's initial value when
+            ``estimate_beta``).
+        kappa_prior: nominal kappa the estimate starts from, N/m^beta.
+        lam_prior: nominal lam, N s/m^(beta+1).
+        prior_rel_std: prior standard deviation of kappa and lam as a
+            fraction of the prior (the RLS's initial covariance too); the
+            RLS never lets a variance exceed it (no covariance wind-up when
+            lam is not excited).
+        noise_std_N: standard deviation of the force residual (sensor noise
+            and model error), N.
+        memory_s: RLS forgetting time constant, s (forgetting factor
+            exp(-dt / memory_s) per sample in contact).
+        kappa_walk_rel_per_sqrt_s: EKF random walk of kappa, fraction of
+            the prior per sqrt(s).
+        lam_walk_rel_per_sqrt_s: EKF random walk of lam, likewise.
+        surface_prior_std_m: EKF prior std of the surface offset, m.
+        surface_walk_m_per_sqrt_s: EKF random walk of the surface offset,
+            m per sqrt(s); 0 keeps the surface of the input (or of first
+            contact).
+        estimate_beta: EKF only: beta joins the state.
+        beta_prior_std: EKF prior std of beta.
+        beta_walk_per_sqrt_s: EKF random walk of beta per sqrt(s).
+        contact_threshold_N: contact when the force exceeds this, N.
+        min_penetration_m: and the penetration exceeds this, m.
+        gate_sigma: innovations are clipped at this many predicted
+            standard deviations (a spike moves the estimate by a bounded
+            step, a real change still gets through).
+        valid_rel_std: the estimate is flagged valid in contact once the
+            std of kappa is below this fraction of kappa_hat.
+        max_gap_s: a sample more than this after the previous one restarts
+            the surface-rate filter (a dropout), s.
+        surface_rate_time_constant_s: low-pass time constant of the surface
+            rate s_dot (finite differences of the surface input), s.
+        max_rel_change: kappa and lam stay within [prior / max_rel_change,
+            prior * max_rel_change].
+    """
+
+    method: str = "rls"
+    beta: float = BEST_BETA
+    kappa_prior: float = 4000.0
+    lam_prior: float = 32000.0
+    prior_rel_std: float = 0.5
+    noise_std_N: float = 0.2
+    memory_s: float = 2.0
+    kappa_walk_rel_per_sqrt_s: float = 0.1
+    lam_walk_rel_per_sqrt_s: float = 0.1
+    surface_prior_std_m: float = 0.002
+    surface_walk_m_per_sqrt_s: float = 0.0
+    estimate_beta: bool = False
+    beta_prior_std: float = 0.1
+    beta_walk_per_sqrt_s: float = 0.0
+    contact_threshold_N: float = CONTACT_THRESHOLD_N
+    min_penetration_m: float = 0.5e-3
+    gate_sigma: float = 4.0
+    valid_rel_std: float = 0.1
+    max_gap_s: float = 0.02
+    surface_rate_time_constant_s: float = 0.02
+    max_rel_change: float = 20.0
+
+    def __post_init__(self):
+        self.validate()
+
+    def validate(self) -> "OnlineEstimatorParams":
+        """Checks every field; returns self (raises VicDrakeError naming it)."""
+        if self.method not in ONLINE_METHODS:
+            raise VicDrakeError(
+                f"OnlineEstimatorParams.method must be one of {list(ONLINE_METHODS)}; "
+                f"got {self.method!r}"
+            )
+        _number("beta", self.beta, low=0.0, low_open=True, high=3.0)
+        for name in ("kappa_prior", "lam_prior", "noise_std_N", "memory_s"):
+            _number(name, getattr(self, name), low=0.0, low_open=True)
+        _number("prior_rel_std", self.prior_rel_std, low=0.0, low_open=True)
+        _number("surface_prior_std_m", self.surface_prior_std_m, low=0.0, low_open=True)
+        _number("beta_prior_std", self.beta_prior_std, low=0.0, low_open=True)
+        for name in (
+            "kappa_walk_rel_per_sqrt_s",
+            "lam_walk_rel_per_sqrt_s",
+            "surface_walk_m_per_sqrt_s",
+            "beta_walk_per_sqrt_s",
+            "contact_threshold_N",
+            "min_penetration_m",
+            "surface_rate_time_constant_s",
+        ):
+            _number(name, getattr(self, name), low=0.0)
+        _number("gate_sigma", self.gate_sigma, low=0.0, low_open=True)
+        _number("valid_rel_std", self.valid_rel_std, low=0.0, low_open=True)
+        _number("max_gap_s", self.max_gap_s, low=0.0, low_open=True)
+        _number("max_rel_change", self.max_rel_change, low=1.0, low_open=True)
+        if not isinstance(self.estimate_beta, bool):
+            raise VicDrakeError(
+                "OnlineEstimatorParams.estimate_beta must be true or false; "
+                f"got {self.estimate_beta!r}"
+            )
+        if self.estimate_beta and self.method != "ekf":
+            raise VicDrakeError(
+                "OnlineEstimatorParams.estimate_beta needs method 'ekf' (the RLS "
+                f"holds beta fixed); got method {self.method!r}"
+            )
+        return self
+
+
+__all__ = ["ONLINE_METHODS", "OnlineEstimatorParams"]

@@ -1,0 +1,26 @@
+"""Safety campaigns: many closed-loop runs with sampled variations, on Dask.
+
+:mod:`.spec` (the campaign YAML), :mod:`.plan` (each run's factors and
+scenario), :mod:`.run` (one run on a worker, its metrics), :mod:`.engine`
+(the Dask cluster, rows on disk, resume), :mod:`.stats` and :mod:`.report`
+(summary.json, summary.html, results.parquet).
+"""
+
+from vic_drake.experiments.campaign.engine import read_rows, run_campaign
+from vic_drake.experiments.campaign.plan import RunPlan, plan_campaign
+from vic_drake.experiments.campaign.run import execute_run, run_metrics
+from vic_drake.experiments.campaign.spec import CampaignSpec, Factor, load_campaign_spec
+from vic_drake.experiments.campaign.stats import wilson_interval
+
+__all__ = [
+    "CampaignSpec",
+    "Factor",
+    "RunPlan",
+    "execute_run",
+    "load_campaign_spec",
+    "plan_campaign",
+    "read_rows",
+    "run_campaign",
+    "run_metrics",
+    "wilson_interval",
+]

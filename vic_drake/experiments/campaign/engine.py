@@ -1,0 +1,246 @@
+"""The campaign engine: runs on a Dask cluster, rows on disk, resume.
+
+:func:`run_campaign` plans every run (checking every scenario before any
+starts), then submits the runs still to do to a Dask cluster: a
+``LocalCluster`` of worker processes, or an existing scheduler by address
+(started with ``dask scheduler`` / ``dask worker``). Workers execute
+:func:`vic_drake.experiments.campaign.run.execute_run` and return plain rows.
+
+The output folder::
+
+    spec.yaml             the campaign spec (a resume must match it)
+    scenarios/RUN.yaml    each finished run's exact scenario (vic-drake scan RUN.yaml)
+    rows/RUN.json         each finished run's row, written atomically
+    results.parquet       every row (written at the end)
+    summary.json, summary.html
+
+A worker that dies loses its current run; the scheduler gives that run to
+another worker once (``distributed.scheduler.allowed-failures`` = 1 on a
+local cluster; an external scheduler uses its own setting), then the run is
+recorded as failed. ``resume`` skips every run with a row and never runs
+one twice.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import pandas as pd
+
+from vic_drake.errors import VicDrakeError
+from vic_drake.experiments.campaign.plan import RunPlan, plan_campaign
+from vic_drake.experiments.campaign.run import failed_row
+from vic_drake.experiments.campaign.spec import CampaignSpec, load_campaign_spec
+from vic_drake.experiments.campaign.stats import per_controller
+from vic_drake.scenario import dumps_scenario, load_scenario
+
+
+def _atomic_write(path: Path, text: str) -> None:
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    tmp.write_text(text)
+    os.replace(tmp, path)
+
+
+def _spec_text(spec: CampaignSpec, base: Path) -> str:
+    from pydrake.common.yaml import yaml_dump_typed
+
+    stored = CampaignSpec(**{**spec.__dict__, "base_scenario": str(base)})
+    return yaml_dump_typed(stored)
+
+
+def read_rows(out: Path) -> pd.DataFrame:
+    """Every finished row of a campaign folder, ordered by run index."""
+    rows = [
+        json.loads(p.read_text()) for p in sorted((out / "rows").glob("run_*.json"))
+    ]
+    df = pd.DataFrame(rows)
+    return df.sort_values("index").reset_index(drop=True) if not df.empty else df
+
+
+def _prepare(out: Path, spec_text: str, plans: list[RunPlan], resume: bool) -> set[str]:
+    """Creates or checks the folder; returns the run ids already finished."""
+    stored = out / "spec.yaml"
+    if stored.exists():
+        if not resume:
+            raise VicDrakeError(
+                f"{str(out)!r} already holds a campaign; pass --resume to finish it "
+                "or choose another --out"
+            )
+        if stored.read_text() != spec_text:
+            raise VicDrakeError(
+                f"{str(out)!r} holds another campaign spec; --resume needs the same spec"
+            )
+    (out / "scenarios").mkdir(parents=True, exist_ok=True)
+    (out / "rows").mkdir(exist_ok=True)
+    _atomic_write(stored, spec_text)
+    planned = {p.run_id for p in plans}
+    return {p.stem for p in (out / "rows").glob("run_*.json")} & planned
+
+
+def _record(out: Path, plan: RunPlan, row: dict) -> None:
+    """Writes a run's scenario, then its row (the row marks the run done)."""
+    text = row.pop("_scenario_yaml", None)
+    if text is None:  # The worker never got to build it (e.g. it died).
+        text = dumps_scenario(plan.scenario())
+    _atomic_write(out / "scenarios" / f"{plan.run_id}.yaml", text)
+    _atomic_write(out / "rows" / f"{plan.run_id}.json", json.dumps(row))
+
+
+class _Progress:
+    def __init__(self, name: str, total: int, done: int, emit: Callable[[str], None]):
+        self.name, self.total, self.emit = name, total, emit
+        self.done0, self.done, self.failed = done, done, 0
+        self.t0 = time.perf_counter()
+
+    def add(self, row: dict) -> None:
+        self.done += 1
+        self.failed += row["status"] != "ok"
+        new = self.done - self.done0
+        elapsed = time.perf_counter() - self.t0
+        rate = new / elapsed * 3600 if elapsed > 0 else 0.0
+        left = self.total - self.done
+        eta = left / rate * 3600 if rate > 0 else float("nan")
+        eta_text = time.strftime("%H:%M:%S", time.gmtime(eta)) if eta == eta else "?"
+        self.emit(
+            f"[{self.name}] {self.done}/{self.total} done, {self.failed} failed, "
+            f"{left} remaining, {rate:.0f} runs/h, ETA {eta_text} "
+            f"({row['run_id']}: {row['status']})"
+        )
+
+
+def _client(workers: int | None, scheduler: str | None):
+    import dask
+    from distributed import Client, LocalCluster
+
+    if scheduler:
+        try:
+            return Client(scheduler, timeout="20s"), None
+        except OSError as exc:
+            raise VicDrakeError(
+                f"cannot reach the Dask scheduler {scheduler!r}: {exc}"
+            ) from None
+    n = workers or os.cpu_count() or 1
+    with dask.config.set({"distributed.scheduler.allowed-failures": 1}):
+        cluster = LocalCluster(
+            n_workers=n,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=":0",  # A free port: never clash with another cluster.
+            env={"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"},
+        )
+    return Client(cluster), cluster
+
+
+def run_campaign(
+    spec_path: str | os.PathLike,
+    out: str | os.PathLike,
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    resume: bool = False,
+    progress: Callable[[str], None] | None = None,
+    max_runs: int | None = None,
+) -> dict:
+    """Runs (or finishes) a campaign; returns its JSON summary.
+
+    Args:
+        spec_path: the campaign YAML.
+        out: output folder (see the module docstring).
+        workers: local worker processes (default: the machine's cores).
+        scheduler: address of an existing Dask scheduler (tcp://host:port).
+        resume: finish the campaign already in ``out``.
+        progress: callable(str) for progress lines (e.g. to stderr).
+        max_runs: stop submitting after this many new runs (for an
+            interrupted campaign in tests and benchmarks; None: all).
+
+    Returns:
+        The summary of :func:`summary_dict` plus ``wall_s``,
+        ``runs_per_hour`` (runs finished by this call) and ``workers``.
+    """
+    if workers is not None and scheduler:
+        raise VicDrakeError("give either --workers or --scheduler, not both")
+    if workers is not None and (isinstance(workers, bool) or workers < 1):
+        raise VicDrakeError(f"--workers must be >= 1; got {workers!r}")
+    spec, base_path = load_campaign_spec(spec_path)
+    plans = plan_campaign(spec, load_scenario(base_path))
+    out = Path(out)
+    done = _prepare(out, _spec_text(spec, base_path), plans, resume)
+    todo = [p for p in plans if p.run_id not in done]
+    if max_runs is not None:
+        todo = todo[:max_runs]
+    emit = progress or (lambda _line: None)
+    bar = _Progress(spec.name, len(plans), len(done), emit)
+    t0 = time.perf_counter()
+    n_workers = 0
+    if todo:
+        n_workers = _submit(todo, out, workers, scheduler, bar, emit)
+    wall = time.perf_counter() - t0
+    rows = read_rows(out)
+    summary = summary_dict(spec, rows)
+    new = bar.done - bar.done0
+    summary.update(
+        wall_s=wall,
+        runs_per_hour=new / wall * 3600 if wall > 0 and new else 0.0,
+        workers=n_workers,
+    )
+    from vic_drake.experiments.campaign.report import write_outputs
+
+    write_outputs(out, spec, rows, summary)
+    return summary
+
+
+def _submit(todo, out: Path, workers, scheduler, bar: _Progress, emit) -> int:
+    from distributed import as_completed
+
+    from vic_drake.experiments.campaign.run import execute_run_in_child
+
+    client, cluster = _client(workers, scheduler)
+    futures = {}
+    try:
+        n_workers = len(client.scheduler_info()["workers"])
+        emit(
+            f"[{bar.name}] {len(todo)} runs on {n_workers} Dask workers ({client.scheduler.address})"
+        )
+        for plan in todo:
+            fut = client.submit(
+                execute_run_in_child,
+                plan,
+                pure=False,
+                key=f"{bar.name}-{plan.run_id}-{time.time_ns()}",
+            )
+            futures[fut] = plan
+        for fut in as_completed(list(futures)):
+            plan = futures[fut]
+            try:
+                row = fut.result()
+            except Exception as exc:  # noqa: BLE001 - e.g. KilledWorker after the retry.
+                row = failed_row(plan, f"{type(exc).__name__}: {exc}")
+            _record(out, plan, row)
+            bar.add(row)
+        return n_workers
+    finally:
+        for fut in futures:
+            fut.cancel()
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def summary_dict(spec: CampaignSpec, rows: pd.DataFrame) -> dict:
+    """runs, finished, failed, nan_runs and per_controller of a campaign's rows."""
+    status = rows["status"] if not rows.empty else pd.Series([], dtype=str)
+    return {
+        "runs": spec.runs,
+        "finished": int(len(rows)),
+        # Failed: raised or produced NaN (nan_runs counts the latter alone).
+        "failed": int((status != "ok").sum()),
+        "nan_runs": int((status == "nan").sum()),
+        "per_controller": per_controller(rows, spec.force_limit_N),
+    }
+
+
+__all__ = ["read_rows", "run_campaign", "summary_dict"]

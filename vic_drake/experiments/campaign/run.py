@@ -1,0 +1,163 @@
+"""One campaign run on a worker: scenario text in, a plain result row out.
+
+:func:`execute_run` is what a Dask worker executes. It builds its own
+Diagram from the run's scenario YAML (Diagrams, Simulators and Contexts do
+not pickle), simulates it and reduces the log to :func:`run_metrics`. A run
+that raises is a row with ``status = "error"`` and the error's text; a run
+whose log holds NaN is ``status = "nan"``. Neither stops the campaign.
+"""
+
+from __future__ import annotations
+
+import math
+import pickle
+import subprocess
+import sys
+import time
+import traceback
+
+import numpy as np
+import pandas as pd
+
+from vic_drake.analysis.contact import contact_loss_intervals, scan_window
+from vic_drake.analysis.scan_metrics import tank_min_J
+from vic_drake.experiments.campaign.plan import RunPlan
+from vic_drake.scenario import dumps_scenario
+
+#: The columns whose non-finite values make a run a NaN run.
+CHECKED_COLUMNS = ("z_m", "force_sensor_z_N", "force_tissue_z_N", "stiffness_z_N_per_m")
+
+#: The metric keys of every row, in order (NaN where a run has none).
+METRIC_KEYS = (
+    "peak_force_N",
+    "p99_force_N",
+    "time_above_limit_s",
+    "contact_loss_s",
+    "tank_min_J",
+    "tank_floor_J",
+    "qp_failures",
+)
+
+
+def run_metrics(df: pd.DataFrame, *, force_limit_N: float) -> dict:
+    """The safety metrics of one run's log.
+
+    The force is the tissue's force on the probe (``force_tissue_z_N``, the
+    force on the patient, not what a faulty sensor reports). Contact losses
+    are :func:`vic_drake.analysis.contact.contact_loss_intervals` inside the
+    scan window. ``qp_failures`` counts logged samples with ``qp_ok`` = 0.
+    """
+    t = df["t_s"].to_numpy(float)
+    f = df["force_tissue_z_N"].to_numpy(float)
+    dt = np.diff(t, append=t[-1] + (t[-1] - t[-2] if t.size > 1 else 0.0))
+    losses = contact_loss_intervals(df, window=scan_window(df))
+    qp_ok = df["qp_ok"].to_numpy(float)
+    return {
+        "peak_force_N": float(np.nanmax(f)),
+        "p99_force_N": float(np.nanpercentile(f, 99)),
+        "time_above_limit_s": float(dt[f > force_limit_N].sum()),
+        "contact_loss_s": float(sum(b - a for a, b in losses)),
+        "tank_min_J": tank_min_J(df),
+        "qp_failures": int(np.sum(qp_ok < 0.5)),
+    }
+
+
+def _nan_columns(df: pd.DataFrame) -> list[str]:
+    return [
+        c for c in CHECKED_COLUMNS if not np.all(np.isfinite(df[c].to_numpy(float)))
+    ]
+
+
+def execute_run(plan: RunPlan) -> dict:
+    """Simulates one run; never raises for a run's own failure.
+
+    Returns:
+        A row: run_id, index, status ("ok" | "nan" | "error"), error (text,
+        "" when ok), the sampled factors (``factor.<name>``), the metrics of
+        :data:`METRIC_KEYS`, sim_s and wall_s; and ``_scenario_yaml``, the
+        run's exact scenario, which the engine stores beside the row.
+    """
+    # Imported here: a worker process pays pydrake's import on its first run.
+    from vic_drake.experiments.scan_run import run_scan
+
+    t0 = time.perf_counter()
+    row = {"run_id": plan.run_id, "index": plan.index, "status": "ok", "error": ""}
+    row.update({f"factor.{k}": v for k, v in plan.factors.items()})
+    row.update({k: math.nan for k in METRIC_KEYS})
+    row["sim_s"] = plan.duration_s
+    try:
+        scenario = plan.scenario()
+        row["_scenario_yaml"] = dumps_scenario(scenario)
+        row["tank_floor_J"] = float(scenario.controller.tank.min_energy_J)
+        result = run_scan(scenario, duration_s=plan.duration_s)
+        df = result.df
+        bad = _nan_columns(df)
+        with np.errstate(all="ignore"):
+            row.update(run_metrics(df, force_limit_N=plan.force_limit_N))
+        if bad:
+            row["status"] = "nan"
+            first = float(
+                df["t_s"].to_numpy()[~np.isfinite(df[bad[0]].to_numpy(float))][0]
+            )
+            row["error"] = f"non-finite values in {bad} from t = {first:.3f} s"
+    except Exception as exc:  # noqa: BLE001 - a run's failure is data.
+        row["status"] = "error"
+        tb = traceback.extract_tb(exc.__traceback__)
+        where = f" at {tb[-1].filename}:{tb[-1].lineno}" if tb else ""
+        row["error"] = f"{type(exc).__name__}: {exc}{where}"
+    row["wall_s"] = time.perf_counter() - t0
+    return row
+
+
+def execute_run_in_child(plan: RunPlan) -> dict:
+    """:func:`execute_run` in a fresh Python process; what the workers run.
+
+    A Diagram with Python LeafSystems is never freed in pydrake (its systems'
+    bound methods keep them alive), so a worker that built one Diagram per
+    run would grow by what each run's systems hold (about 100 MB a run on
+    the synthetic chest: docs/decisions.md, "One process per campaign run").
+    The child's memory goes back to the system when it exits, and a crash
+    of the simulation (a signal, not an exception) costs this run only: it
+    becomes an error row, and the worker goes on.
+    """
+    t0 = time.perf_counter()
+    proc = subprocess.run(
+        [sys.executable, "-m", "vic_drake.experiments.campaign.child"],
+        input=pickle.dumps(plan),
+        capture_output=True,
+        check=False,
+    )
+    if proc.returncode == 0:
+        try:
+            return pickle.loads(proc.stdout)
+        except Exception as exc:  # noqa: BLE001 - reported as the run's error.
+            reason = f"unreadable result ({type(exc).__name__}: {exc})"
+    else:
+        reason = f"the run's process exited with status {proc.returncode}"
+    tail = proc.stderr.decode(errors="replace").strip().splitlines()[-3:]
+    error = reason + (": " + " | ".join(tail) if tail else "")
+    return failed_row(plan, error, wall_s=time.perf_counter() - t0)
+
+
+def failed_row(plan: RunPlan, error: str, *, wall_s: float = math.nan) -> dict:
+    """The row of a run that produced no log (its metrics NaN)."""
+    row = {
+        "run_id": plan.run_id,
+        "index": plan.index,
+        "status": "error",
+        "error": error,
+    }
+    row.update({f"factor.{k}": v for k, v in plan.factors.items()})
+    row.update({k: math.nan for k in METRIC_KEYS})
+    row.update(sim_s=plan.duration_s, wall_s=wall_s)
+    return row
+
+
+__all__ = [
+    "CHECKED_COLUMNS",
+    "METRIC_KEYS",
+    "execute_run",
+    "execute_run_in_child",
+    "failed_row",
+    "run_metrics",
+]

@@ -1,0 +1,121 @@
+"""Campaign statistics: exceedance probability with its interval, per controller."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+
+#: z of a two-sided 95 % interval.
+Z95 = 1.959963984540054
+
+
+def wilson_interval(successes: int, n: int, z: float = Z95) -> tuple[float, float]:
+    """Wilson score interval of a binomial proportion (NaN, NaN for n = 0).
+
+    Unlike the normal approximation it stays inside [0, 1] and is not empty
+    at 0 or n successes, which a safety campaign with no exceedance needs.
+    """
+    if n <= 0:
+        return (math.nan, math.nan)
+    p = successes / n
+    denom = 1 + z * z / n
+    centre = (p + z * z / (2 * n)) / denom
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / denom
+    return (max(0.0, centre - half), min(1.0, centre + half))
+
+
+def _finite(values) -> np.ndarray:
+    v = np.asarray(values, float)
+    return v[np.isfinite(v)]
+
+
+def _stat(values, fn) -> float:
+    v = _finite(values)
+    return float(fn(v)) if v.size else math.nan
+
+
+def per_controller(rows: pd.DataFrame, force_limit_N: float) -> dict:
+    """{controller: runs, peak force p50/max, exceedance and CI, contact loss, tank min}.
+
+    Runs with status "error" count in ``runs`` but not in the statistics;
+    a NaN run's peak force is its finite part's maximum (its row says NaN).
+    ``exceed_prob`` is the share of scored runs whose peak force exceeds the
+    force limit.
+    """
+    out = {}
+    if rows.empty:
+        return out
+    for name, group in rows.groupby("factor.controller", sort=True):
+        scored = group[group["status"] != "error"]
+        peaks = _finite(scored["peak_force_N"])
+        exceed = int(np.sum(peaks > force_limit_N))
+        lo, hi = wilson_interval(exceed, peaks.size)
+        out[str(name)] = {
+            "runs": int(len(group)),
+            "peak_force_N_p50": _stat(peaks, np.median),
+            "peak_force_N_max": _stat(peaks, np.max),
+            "exceed_prob": exceed / peaks.size if peaks.size else math.nan,
+            "exceed_prob_ci95": [lo, hi],
+            "contact_loss_s_p50": _stat(scored["contact_loss_s"], np.median),
+            "tank_min_J": _stat(scored["tank_min_J"], np.min),
+        }
+    return out
+
+
+def factor_effects(rows: pd.DataFrame, metric: str = "peak_force_N") -> list[dict]:
+    """Each factor's effect on a metric, per controller.
+
+    Numeric factors: Spearman's rank correlation and the metric's change
+    from the factor's lowest to its highest third (median of each).
+    Label factors: the metric's median per level.
+    """
+    effects = []
+    ok = rows[rows["status"] != "error"]
+    factor_cols = [
+        c for c in rows.columns if c.startswith("factor.") and c != "factor.controller"
+    ]
+    for col in factor_cols:
+        for name, group in ok.groupby("factor.controller", sort=True):
+            x = group[col]
+            y = group[metric].to_numpy(float)
+            entry = {"factor": col[len("factor.") :], "controller": str(name)}
+            if pd.api.types.is_numeric_dtype(x) and x.nunique() > 2:
+                xv = x.to_numpy(float)
+                keep = np.isfinite(xv) & np.isfinite(y)
+                xv, yv = xv[keep], y[keep]
+                if xv.size < 3:
+                    continue
+                rho = pd.Series(xv).rank().corr(pd.Series(yv).rank())
+                lo, hi = np.quantile(xv, [1 / 3, 2 / 3])
+                entry.update(
+                    kind="numeric",
+                    spearman=float(rho) if np.isfinite(rho) else math.nan,
+                    low_third_median=_stat(yv[xv <= lo], np.median),
+                    high_third_median=_stat(yv[xv >= hi], np.median),
+                )
+            else:
+                entry.update(
+                    kind="levels",
+                    medians={
+                        str(k): _stat(g[metric], np.median)
+                        for k, g in group.groupby(col)
+                    },
+                )
+            effects.append(entry)
+    return effects
+
+
+def worst_runs(rows: pd.DataFrame, n: int = 10) -> pd.DataFrame:
+    """The n worst runs: failed ones first, then by peak force, then contact loss."""
+    if rows.empty:
+        return rows
+    order = rows.assign(
+        _failed=(rows["status"] != "ok").astype(int),
+        _peak=rows["peak_force_N"].fillna(np.inf),
+    ).sort_values(["_failed", "_peak", "contact_loss_s"], ascending=False)
+    return order.drop(columns=["_failed", "_peak"]).head(n)
+
+
+__all__ = ["Z95", "factor_effects", "per_controller", "wilson_interval", "worst_runs"]

@@ -1,0 +1,175 @@
+"""OnlineEstimatorSystem: the RLS or EKF tissue estimator as a LeafSystem.
+
+A thin adapter over :mod:`vic_drake.estimation.online`: every period it
+reads the probe's position and velocity, the F/T force and (optionally) the
+surface height, calls the pure step function of the chosen method and
+stores the filter state and the estimate in discrete state; the outputs
+publish the estimate from state (the values of the last tick).
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+
+import numpy as np
+from pydrake.systems.framework import BasicVector, LeafSystem
+
+from vic_drake.errors import VicDrakeError
+from vic_drake.estimation.online import (
+    OUTPUT_FIELDS,
+    OnlineEstimatorParams,
+    estimator_functions,
+)
+
+#: Index of each field in the "estimate" output.
+ESTIMATE_SIZE = len(OUTPUT_FIELDS)
+_I = {name: i for i, name in enumerate(OUTPUT_FIELDS)}
+
+
+class OnlineEstimatorSystem(LeafSystem):
+    """Online kappa, lambda (and surface) estimate from force and motion.
+
+    Input ports:
+        probe.position (3): probe tip p_WP, m.
+        probe.velocity (3): v_WP, m/s.
+        ft_sensor.force_W (3): F/T force in W, N, sensor convention
+            (negative z = pressing; the tissue force is minus its z).
+        surface_z (1): tissue surface height under the probe, m (only with
+            ``surface_input=True``; NaN = unknown). Without it the surface
+            is latched at first contact (and corrected by the EKF when its
+            surface state is on), or, with ``surface_map`` (a Phantom), read
+            from the map under the probe.
+
+    Output ports (state: the last tick's estimate):
+        estimate (7): :data:`vic_drake.estimation.online.OUTPUT_FIELDS`.
+        kappa_hat (1), lambda_hat (1), variances (2: kappa, lambda),
+        valid (1), surface_z_hat (1).
+
+    A non-finite input leaves the estimate unchanged (never a NaN
+    estimate); ``valid`` is 0 on that tick.
+    """
+
+    def __init__(
+        self,
+        params: OnlineEstimatorParams,
+        *,
+        period_s: float,
+        surface_input: bool = True,
+        surface_map=None,
+    ):
+        super().__init__()
+        if not isinstance(params, OnlineEstimatorParams):
+            raise VicDrakeError(
+                f"OnlineEstimatorSystem needs OnlineEstimatorParams; got {params!r}"
+            )
+        if not (math.isfinite(period_s) and period_s > 0.0):
+            raise VicDrakeError(f"period_s must be > 0; got {period_s!r}")
+        self._params = copy.deepcopy(params).validate()
+        init, self._step = estimator_functions(self._params)
+        state0 = init(self._params)
+        _, est0 = self._step(
+            state0, 0.0, 0.0, 0.0, math.nan, math.nan, self._params
+        )  # A fault sample: the prior's outputs, state unchanged but the count.
+        self._position_port = self.DeclareVectorInputPort("probe.position", 3)
+        self._velocity_port = self.DeclareVectorInputPort("probe.velocity", 3)
+        self._force_port = self.DeclareVectorInputPort("ft_sensor.force_W", 3)
+        if surface_input and surface_map is not None:
+            raise VicDrakeError("give either surface_input or surface_map, not both")
+        self._surface_port = (
+            self.DeclareVectorInputPort("surface_z", 1) if surface_input else None
+        )
+        # The map's surface under the probe (a Phantom's point lookup).
+        self._surface_lookup = (
+            None if surface_map is None else surface_map.point_lookup()
+        )
+        self._filter = self.DeclareDiscreteState(np.asarray(state0, float))
+        self._estimate = self.DeclareDiscreteState(np.asarray(est0, float))
+        self.DeclarePeriodicDiscreteUpdateEvent(float(period_s), 0.0, self._update)
+        self._ports = {
+            "estimate": self.DeclareStateOutputPort("estimate", self._estimate)
+        }
+        for name, part in (
+            ("kappa_hat", [_I["kappa_hat"]]),
+            ("lambda_hat", [_I["lambda_hat"]]),
+            ("variances", [_I["kappa_var"], _I["lambda_var"]]),
+            ("valid", [_I["valid"]]),
+            ("surface_z_hat", [_I["surface_z_m"]]),
+        ):
+            self._ports[name] = self.DeclareVectorOutputPort(
+                name, len(part), self._make_output(part), {self.xd_ticket()}
+            )
+
+    def _make_output(self, part):
+        def calc(context, output: BasicVector):
+            values = context.get_discrete_state(self._estimate).get_value()
+            output.SetFromVector(values[part])
+
+        return calc
+
+    def _update(self, context, discrete_state):
+        p = self._position_port.Eval(context)
+        v = self._velocity_port.Eval(context)
+        f = self._force_port.Eval(context)
+        if self._surface_port is not None:
+            s = float(self._surface_port.Eval(context)[0])
+        elif self._surface_lookup is not None and math.isfinite(p[0] + p[1]):
+            s = self._surface_lookup(float(p[0]), float(p[1]))[0]
+        else:
+            s = math.nan
+        state = context.get_discrete_state(self._filter).get_value().tolist()
+        state, est = self._step(
+            state,
+            context.get_time(),
+            float(p[2]),
+            float(v[2]),
+            -float(f[2]),
+            s,
+            self._params,
+        )
+        discrete_state.set_value(self._filter, state)
+        discrete_state.set_value(self._estimate, est)
+
+    def get_estimate_output_port(self):
+        return self._ports["estimate"]
+
+    def get_kappa_output_port(self):
+        return self._ports["kappa_hat"]
+
+    def get_lambda_output_port(self):
+        return self._ports["lambda_hat"]
+
+    def get_variances_output_port(self):
+        return self._ports["variances"]
+
+    def get_valid_output_port(self):
+        return self._ports["valid"]
+
+    def get_surface_output_port(self):
+        return self._ports["surface_z_hat"]
+
+
+class RlsEstimatorSystem(OnlineEstimatorSystem):
+    """:class:`OnlineEstimatorSystem` with the recursive least squares."""
+
+    def __init__(self, params: OnlineEstimatorParams, **kwargs):
+        params = copy.deepcopy(params)
+        params.method = "rls"
+        super().__init__(params, **kwargs)
+
+
+class EkfEstimatorSystem(OnlineEstimatorSystem):
+    """:class:`OnlineEstimatorSystem` with the EKF."""
+
+    def __init__(self, params: OnlineEstimatorParams, **kwargs):
+        params = copy.deepcopy(params)
+        params.method = "ekf"
+        super().__init__(params, **kwargs)
+
+
+__all__ = [
+    "ESTIMATE_SIZE",
+    "EkfEstimatorSystem",
+    "OnlineEstimatorSystem",
+    "RlsEstimatorSystem",
+]

@@ -1,0 +1,96 @@
+"""A phantom as a wrong map sees it: scaled kappa and lambda, offset and shift.
+
+The controller reads its own map of the tissue; :func:`with_map_errors` gives
+that map with the errors of a real estimate: kappa and lambda scaled, the
+surface raised (``surface_offset_m`` > 0: the map puts the surface higher
+than it is) and the whole map shifted in x and y (a registration error: the
+map's feature at (x, y) appears at (x + shift_x, y + shift_y)).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from vic_drake.tissue.phantom.base import Phantom, TissueSample
+from vic_drake.tissue.phantom.grid import GridPhantom
+
+
+class DistortedPhantom(Phantom):
+    """Another phantom seen through map errors (see the module docstring)."""
+
+    def __init__(
+        self,
+        base: Phantom,
+        *,
+        kappa_scale: float,
+        lam_scale: float,
+        surface_offset_m: float,
+        shift_x_m: float,
+        shift_y_m: float,
+    ):
+        self._base = base
+        self._errors = (
+            float(kappa_scale),
+            float(lam_scale),
+            float(surface_offset_m),
+            float(shift_x_m),
+            float(shift_y_m),
+        )
+        self.beta = base.beta
+        self.name = f"{getattr(base, 'name', 'phantom')} (map errors)"
+
+    @property
+    def bounds(self):
+        x0, x1, y0, y1 = self._base.bounds
+        _, _, _, sx, sy = self._errors
+        return (x0 + sx, x1 + sx, y0 + sy, y1 + sy)
+
+    def sample(self, x, y) -> TissueSample:
+        ks, ls, dz, sx, sy = self._errors
+        s = self._base.sample(np.asarray(x, float) - sx, np.asarray(y, float) - sy)
+        return TissueSample(
+            s.surface_z_m + dz, s.dz_dx, s.dz_dy, ks * s.kappa, ls * s.lam
+        )
+
+
+def with_map_errors(
+    phantom: Phantom,
+    *,
+    kappa_scale: float = 1.0,
+    lam_scale: float = 1.0,
+    surface_offset_m: float = 0.0,
+    shift_x_m: float = 0.0,
+    shift_y_m: float = 0.0,
+) -> Phantom:
+    """The phantom as a map with these errors; the phantom itself when none.
+
+    A :class:`GridPhantom` stays a grid (same lookup, axes shifted, grids
+    scaled), so the controller's nearest-point lookup is kept; any other
+    phantom is wrapped in a :class:`DistortedPhantom`.
+    """
+    errors = (kappa_scale, lam_scale, surface_offset_m, shift_x_m, shift_y_m)
+    if errors == (1.0, 1.0, 0.0, 0.0, 0.0):
+        return phantom
+    if isinstance(phantom, GridPhantom):
+        return GridPhantom(
+            x_m=phantom.x_m + shift_x_m,
+            y_m=phantom.y_m + shift_y_m,
+            z_m=phantom.surface_m - phantom.surface_offset_m,
+            kappa=phantom.kappa_grid * kappa_scale,
+            lam=phantom.lam_grid * lam_scale,
+            beta=phantom.beta,
+            surface_offset_m=phantom.surface_offset_m + surface_offset_m,
+            lookup=phantom.lookup,
+            name=f"{phantom.name} (map errors)",
+        )
+    return DistortedPhantom(
+        phantom,
+        kappa_scale=kappa_scale,
+        lam_scale=lam_scale,
+        surface_offset_m=surface_offset_m,
+        shift_x_m=shift_x_m,
+        shift_y_m=shift_y_m,
+    )
+
+
+__all__ = ["DistortedPhantom", "with_map_errors"]
