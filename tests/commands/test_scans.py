@@ -4,8 +4,8 @@ import json
 
 import pytest
 
+from vic_drake.analysis.real_comparison import COMPARE_REAL_KEYS as COMPARE_KEYS
 from vic_drake.cli import main
-from vic_drake.commands.scans import COMPARE_KEYS
 
 
 def test_compare_real_missing_bag_is_a_clean_error(tmp_path, capsys):

@@ -16,6 +16,19 @@ from vic_drake.analysis.contact import (
 from vic_drake.analysis.scan_metrics import peak_force_N, tank_min_J
 from vic_drake.errors import VicDrakeError
 
+#: The keys that `vic-drake compare-real` always prints first, in this order
+#: (its JSON contract); the reproduce report shows the same.
+COMPARE_REAL_KEYS = (
+    "controller",
+    "duration_s",
+    "force_rmse_N",
+    "force_peak_err_N",
+    "z_rmse_mm",
+    "kz_corr",
+    "tank_min_J",
+    "rtf",
+)
+
 
 def resample(df: pd.DataFrame, t_s: np.ndarray, columns) -> dict[str, np.ndarray]:
     """Linear interpolation of columns at times t_s (NaN outside the record)."""

@@ -24,18 +24,6 @@ from vic_drake.commands.common import (
 from vic_drake.errors import VicDrakeError
 from vic_drake.paths import PLOT_SUFFIXES, check_output_file
 
-#: The keys compare-real always prints (its contract), in order.
-COMPARE_KEYS = (
-    "controller",
-    "duration_s",
-    "force_rmse_N",
-    "force_peak_err_N",
-    "z_rmse_mm",
-    "kz_corr",
-    "tank_min_J",
-    "rtf",
-)
-
 
 def _positive(value: str, option: str) -> float:
     try:
@@ -137,6 +125,7 @@ def _save_log(df, out: str) -> Path:
 
 
 def run_compare_real(args: argparse.Namespace) -> int:
+    from vic_drake.analysis.real_comparison import COMPARE_REAL_KEYS
     from vic_drake.experiments import compare_real
 
     stiffness = (
@@ -168,7 +157,7 @@ def run_compare_real(args: argparse.Namespace) -> int:
         from vic_drake.reproduce.plots.scans import plot_comparison
 
         plot_comparison(sim, real, title=Path(args.bag_dir).name, save_path=args.plot)
-    ordered = {k: out.get(k) for k in COMPARE_KEYS}
+    ordered = {k: out.get(k) for k in COMPARE_REAL_KEYS}
     ordered.update({k: v for k, v in out.items() if k not in ordered})
     kz = "n/a" if ordered["kz_corr"] is None else f"{ordered['kz_corr']:.3f}"
     human = (

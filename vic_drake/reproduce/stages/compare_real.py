@@ -5,22 +5,11 @@ from __future__ import annotations
 
 import os
 
+from vic_drake.analysis.real_comparison import COMPARE_REAL_KEYS
 from vic_drake.reproduce.context import RunContext, StageSkipped
 from vic_drake.reproduce.report import ReportTable
 from vic_drake.reproduce.stages.real_scans import REAL_SCAN_LOGS
 from vic_drake.reproduce.workers import worker_pool
-
-#: Keys of vic_drake.experiments.compare_real shown in the report.
-COMPARE_REAL_KEYS = (
-    "controller",
-    "duration_s",
-    "force_rmse_N",
-    "force_peak_err_N",
-    "z_rmse_mm",
-    "kz_corr",
-    "tank_min_J",
-    "rtf",
-)
 
 
 def _compare_real_job(args):
