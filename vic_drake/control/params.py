@@ -16,10 +16,9 @@ loaded from YAML are checked too. Every message names the field and the value.
 the field types at run time.)
 """
 
-import math
 from dataclasses import dataclass, field
 
-from vic_drake.errors import VicDrakeError
+from vic_drake.errors import VicDrakeError, check_number
 from vic_drake.paper import CONTACT_THRESHOLD_N, CONTROLLERS
 
 __all__ = [
@@ -36,16 +35,6 @@ __all__ = [
 SURFACE_VELOCITY_MODES = ("moving_average", "gradient")
 
 
-def _finite(owner: str, name: str, value) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise VicDrakeError(f"{owner}.{name} must be a number; got {value!r}") from None
-    if not math.isfinite(v):
-        raise VicDrakeError(f"{owner}.{name} must be finite; got {value!r}")
-    return v
-
-
 def _vec3(owner: str, name: str, value) -> list[float]:
     try:
         items = list(value)
@@ -57,11 +46,11 @@ def _vec3(owner: str, name: str, value) -> list[float]:
         raise VicDrakeError(
             f"{owner}.{name} must be 3 numbers (x, y, z); got {value!r}"
         )
-    return [_finite(owner, f"{name}[{i}]", v) for i, v in enumerate(items)]
+    return [check_number(owner, f"{name}[{i}]", v) for i, v in enumerate(items)]
 
 
 def _positive(owner: str, name: str, value) -> float:
-    v = _finite(owner, name, value)
+    v = check_number(owner, name, value)
     if not v > 0.0:
         raise VicDrakeError(f"{owner}.{name} must be > 0; got {value!r}")
     return v
@@ -97,17 +86,17 @@ class TankParams:
     def validate(self) -> "TankParams":
         o = "TankParams"
         t_min = _positive(o, "min_energy_J", self.min_energy_J)
-        t_max = _finite(o, "max_energy_J", self.max_energy_J)
+        t_max = check_number(o, "max_energy_J", self.max_energy_J)
         if not t_max > t_min:
             raise VicDrakeError(
                 f"{o}.max_energy_J must be > min_energy_J ({t_min!r}); got {self.max_energy_J!r}"
             )
-        t0 = _finite(o, "initial_energy_J", self.initial_energy_J)
+        t0 = check_number(o, "initial_energy_J", self.initial_energy_J)
         if t0 < 0.0:
             raise VicDrakeError(
                 f"{o}.initial_energy_J must be >= 0; got {self.initial_energy_J!r}"
             )
-        eta = _finite(o, "power_limit_W", self.power_limit_W)
+        eta = check_number(o, "power_limit_W", self.power_limit_W)
         if not eta < 0.0:
             raise VicDrakeError(
                 f"{o}.power_limit_W (eta, the most negative tank power) must be < 0; "
@@ -187,7 +176,7 @@ class StiffnessQpParams:
                 raise VicDrakeError(
                     f"{o}.force_min_N[{i}] = {f_min[i]!r} must be < force_max_N[{i}] = {f_max[i]!r}"
                 )
-        zeta = _finite(o, "damping_ratio", self.damping_ratio)
+        zeta = check_number(o, "damping_ratio", self.damping_ratio)
         if zeta < 0.0:
             raise VicDrakeError(
                 f"{o}.damping_ratio must be >= 0; got {self.damping_ratio!r}"
@@ -263,14 +252,14 @@ class ReferenceParams:
                 f"{o}.controller must be one of {list(CONTROLLERS)}; got {self.controller!r}"
             )
         _positive(o, "force_ref_N", self.force_ref_N)
-        if not _finite(o, "force_min_z_N", self.force_min_z_N) < 0.0:
+        if not check_number(o, "force_min_z_N", self.force_min_z_N) < 0.0:
             raise VicDrakeError(
                 f"{o}.force_min_z_N must be < 0 (sensor convention, pressing); "
                 f"got {self.force_min_z_N!r}"
             )
         _positive(o, "eps_max_m", self.eps_max_m)
         _positive(o, "eps_d_m", self.eps_d_m)
-        if _finite(o, "contact_threshold_N", self.contact_threshold_N) < 0.0:
+        if check_number(o, "contact_threshold_N", self.contact_threshold_N) < 0.0:
             raise VicDrakeError(
                 f"{o}.contact_threshold_N must be >= 0; got {self.contact_threshold_N!r}"
             )

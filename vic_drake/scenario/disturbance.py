@@ -3,8 +3,7 @@
 import math
 from dataclasses import dataclass, field
 
-from vic_drake.errors import VicDrakeError
-from vic_drake.scenario.checks import check_number
+from vic_drake.errors import VicDrakeError, check_number
 
 
 @dataclass

@@ -2,7 +2,7 @@
 
 from dataclasses import dataclass
 
-from vic_drake.scenario.checks import check_number
+from vic_drake.errors import check_number
 
 
 @dataclass

@@ -23,9 +23,8 @@ from vic_drake.control.params import (
     ReferenceParams,
     StiffnessQpParams,
 )
-from vic_drake.errors import VicDrakeError
+from vic_drake.errors import VicDrakeError, check_number
 from vic_drake.estimation.online import OnlineEstimatorParams
-from vic_drake.scenario.checks import check_number
 from vic_drake.scenario.disturbance import DisturbanceConfig
 from vic_drake.scenario.logging import LoggingConfig
 from vic_drake.scenario.phantom import PhantomConfig

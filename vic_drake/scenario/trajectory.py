@@ -2,8 +2,7 @@
 
 from dataclasses import dataclass, field
 
-from vic_drake.errors import VicDrakeError
-from vic_drake.scenario.checks import check_number
+from vic_drake.errors import VicDrakeError, check_number
 
 
 @dataclass

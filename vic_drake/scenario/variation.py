@@ -17,8 +17,7 @@ is off by default, so a scenario without it runs the paper's scan unchanged:
 from dataclasses import dataclass, field
 
 from vic_drake.control.sensor_faults import DROPOUT_MODES
-from vic_drake.errors import VicDrakeError
-from vic_drake.scenario.checks import check_number
+from vic_drake.errors import VicDrakeError, check_number
 from vic_drake.tissue.motion import load_motion_trace
 from vic_drake.tissue.phantom.population import (
     POPULATION_RANGES,

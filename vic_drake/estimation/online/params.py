@@ -6,10 +6,9 @@ that ``yaml_load_typed`` fills (no ``from __future__ import annotations``:
 the loader reads the field types at run time).
 """
 
-import math
 from dataclasses import dataclass
 
-from vic_drake.errors import VicDrakeError
+from vic_drake.errors import VicDrakeError, check_number
 from vic_drake.paper import BEST_BETA, CONTACT_THRESHOLD_N
 
 #: The online estimators, by name.
@@ -17,19 +16,13 @@ ONLINE_METHODS = ("rls", "ekf")
 
 
 def _number(name: str, value, *, low=None, low_open=False, high=None) -> float:
-    o = "OnlineEstimatorParams"
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise VicDrakeError(f"{o}.{name} must be a number; got {value!r}") from None
-    if isinstance(value, bool) or not math.isfinite(v):
-        raise VicDrakeError(f"{o}.{name} must be a finite number; got {value!r}")
-    if low is not None and (v < low or (low_open and v == low)):
-        sign = ">" if low_open else ">="
-        raise VicDrakeError(f"{o}.{name} must be {sign} {low}; got {value!r}")
-    if high is not None and v > high:
-        raise VicDrakeError(f"{o}.{name} must be <= {high}; got {value!r}")
-    return v
+    if isinstance(value, bool):
+        raise VicDrakeError(
+            f"OnlineEstimatorParams.{name} must be a number; got {value!r}"
+        )
+    return check_number(
+        "OnlineEstimatorParams", name, value, low=low, low_open=low_open, high=high
+    )
 
 
 @dataclass
