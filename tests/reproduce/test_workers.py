@@ -65,7 +65,8 @@ def test_sigint_stops_the_scan_workers_within_2_s(tmp_path):
         assert workers, "no worker process started"
         t0 = time.monotonic()
         proc.send_signal(signal.SIGINT)
-        rc = proc.wait(timeout=30)
+        rest = proc.communicate(timeout=30)[1]
+        rc = proc.returncode
         stopped = time.monotonic() - t0
         while any(_alive(w) for w in workers) and time.monotonic() - t0 < 30:
             time.sleep(0.05)
@@ -73,7 +74,7 @@ def test_sigint_stops_the_scan_workers_within_2_s(tmp_path):
     finally:
         if proc.poll() is None:
             proc.kill()
-    assert rc == 130
+    assert rc == 130, f"exit {rc}; the run's last words:\n{rest[-3000:]}"
     assert stopped <= STOP_LIMIT_S, f"main process took {stopped:.2f} s"
     assert all_gone <= STOP_LIMIT_S, f"workers took {all_gone:.2f} s"
     # Nothing at --out; the partial run is marked incomplete beside it.

@@ -18,6 +18,7 @@ from typing import Any
 
 from vic_drake.analysis.claims import PASS, claim_status
 from vic_drake.reproduce.context import RunContext, StageRecord, StageSkipped
+from vic_drake.reproduce.interrupt import interrupted, sigint_watch
 from vic_drake.reproduce.options import ReproduceOptions
 from vic_drake.reproduce.run_dir import RUN_FILE, finish_run_dir, prepare_run_dir
 from vic_drake.reproduce.stages.claims import stage_claims
@@ -91,6 +92,8 @@ def run_pipeline(ctx: RunContext) -> None:
             )
             ctx.progress(f"[{i + 1}/{len(names)}] {name} skipped: {exc}")
         except Exception as exc:  # noqa: BLE001 - a failed stage is reported, not fatal
+            if interrupted():  # Ctrl-C that came back wrapped in another error.
+                raise KeyboardInterrupt from exc
             msg = f"{type(exc).__name__}: {exc}"
             rec = StageRecord(name, False, time.perf_counter() - t0, msg)
             ctx.progress(f"[{i + 1}/{len(names)}] {name} FAILED: {msg}")
@@ -99,6 +102,8 @@ def run_pipeline(ctx: RunContext) -> None:
             with log.open("a", encoding="utf-8") as fh:
                 fh.write(f"--- stage {name}\n{traceback.format_exc()}\n")
         ctx.records.append(rec)
+        if interrupted():  # Ctrl-C that a library swallowed.
+            raise KeyboardInterrupt
 
 
 def reproduce(options: ReproduceOptions) -> ReproduceResult:
@@ -117,7 +122,8 @@ def reproduce(options: ReproduceOptions) -> ReproduceResult:
     ctx = RunContext(options, work_dir=work)
     t0 = time.perf_counter()
     try:
-        run_pipeline(ctx)
+        with sigint_watch():
+            run_pipeline(ctx)
     except BaseException:
         options.progress(
             f"run stopped; its partial outputs are in {str(work)!r}, marked "
