@@ -57,7 +57,7 @@ def _estimate_online(args: argparse.Namespace) -> int:
     params = OnlineEstimatorParams(
         method=args.method, beta=args.beta, surface_walk_m_per_sqrt_s=walk
     )
-    result = replay_online(path, params=params, lag_s=args.lag, data_dir=args.data_dir)
+    result = replay_online(path, params=params, lag_s=args.lag)
     s = result.summary
     ref = (
         "offline least-squares fit of the whole log"

@@ -9,8 +9,9 @@
   :func:`~vic_drake.estimation.palpation.estimate_lag`, as
   ``vic-drake fit-palpation`` reports it). The surface is the log's.
 - a 31-column log of the variable-impedance controller (a VS scan): the
-  reference is the measured GP map's kappa and lam at the probe's (x, y)
-  (bilinear); the surface input is the map's surface there.
+  reference is the GP map's kappa and lam that the controller logged at
+  each tick (its nearest map point); the surface input is the one it acted
+  on, the tip height plus its logged penetration. No map file is needed.
 
 The estimator pairs each force sample with the position of ``lag_s``
 earlier (a delay line, causal): by default the offline lag estimate on a
@@ -25,7 +26,6 @@ the 99th percentile of the tick's wall time.
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -95,23 +95,20 @@ def _palpation_inputs(df, params, lag_s):
     return inputs, np.full(n, fit.kappa), np.full(n, fit.lam), lag_s
 
 
-def _scan_inputs(df, phantom, lag_s):
+def _scan_inputs(df, lag_s):
     t = df["t_s"].to_numpy(float)
-    x, y = df["x_m"].to_numpy(float), df["y_m"].to_numpy(float)
-    tissue = phantom.sample(np.nan_to_num(x), np.nan_to_num(y))
-    surface = np.where(np.isfinite(x + y), tissue.surface_z_m, np.nan)
+    z = df["z_m"].to_numpy(float)
+    # The surface the controller acted on: its logged penetration is measured
+    # from the map's nearest grid point + 0.0025 m, 1.5 mm above the tip's
+    # logged z plus our bilinear map (docs/decisions.md, "Online replay on
+    # scan logs: the controller's own surface").
+    surface = z + df["penetration_m"].to_numpy(float)
     force = -df["sensor_force_z_N"].to_numpy(float)
-    inputs = (
-        t,
-        df["z_m"].to_numpy(float),
-        df["vz_m_per_s"].to_numpy(float),
-        force,
-        surface,
-    )
+    inputs = (t, z, df["vz_m_per_s"].to_numpy(float), force, surface)
     return (
         inputs,
-        np.asarray(tissue.kappa, float),
-        np.asarray(tissue.lam, float),
+        df["kappa_N_per_m_beta"].to_numpy(float),
+        df["lambda_N_s_per_m_beta1"].to_numpy(float),
         (0.0 if lag_s is None else lag_s),
     )
 
@@ -121,7 +118,6 @@ def replay_online(
     *,
     params: OnlineEstimatorParams | None = None,
     lag_s: float | None = None,
-    data_dir: str | os.PathLike | None = None,
 ) -> OnlineReplay:
     """Runs the online estimator over a real log and scores it.
 
@@ -130,11 +126,10 @@ def replay_online(
         params: estimator settings (default: RLS defaults).
         lag_s: force-after-position delay, s (>= 0); None = the default of
             the log's kind (module docstring).
-        data_dir: data folder holding ``phantom_map`` (scans only).
 
     Raises:
         VicDrakeError: another layout, a bad lag, too few samples in
-            contact, or (scans) no measured map.
+            contact.
     """
     params = OnlineEstimatorParams() if params is None else params
     params.validate()
@@ -154,11 +149,8 @@ def replay_online(
         kind = "palpation"
         inputs, kappa_ref, lam_ref, lag = _palpation_inputs(df, params, lag_s)
     else:
-        from vic_drake.tissue.phantom import load_phantom
-
         kind = "scan"
-        phantom = load_phantom("measured", data_dir=data_dir)
-        inputs, kappa_ref, lam_ref, lag = _scan_inputs(df, phantom, lag_s)
+        inputs, kappa_ref, lam_ref, lag = _scan_inputs(df, lag_s)
     t, z, vz, force, surface = inputs
     period = float(np.median(np.diff(t)))
     d = int(round(lag / period)) if period > 0 else 0
