@@ -45,6 +45,7 @@ MIN_IMAGES = {
     "02_scan_controllers.ipynb": 1,
     "03_disturbance.ipynb": 2,
     "04_real_vs_sim.ipynb": 1,
+    "05_online_estimation.ipynb": 2,
 }
 
 

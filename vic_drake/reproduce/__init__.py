@@ -20,6 +20,9 @@ Stages (see :data:`STAGES`):
 - ``real_scans``: the paper's scan logs reduced to the same metrics.
 - ``compare_real``: (full mode) each real scan re-run in simulation on the
   measured map and compared with its log.
+- ``online``: the online kappa/lambda estimators (RLS, EKF) replayed tick by
+  tick over the paper's palpation and VS scan logs and this run's simulated
+  VS-VF scan.
 - ``claims``: C1-C7 (:mod:`vic_drake.analysis.claims`) -> ``claims.json``.
 - ``replay``: a Meshcat recording of one scan -> ``replay.html``.
 - ``report``: ``report.html`` (:mod:`vic_drake.reproduce.report`; figures

@@ -26,6 +26,7 @@ from vic_drake.reproduce.stages.compare_real import stage_compare_real
 from vic_drake.reproduce.stages.map import stage_map
 from vic_drake.reproduce.stages.offline_real import stage_offline_real
 from vic_drake.reproduce.stages.offline_sim import stage_offline_sim
+from vic_drake.reproduce.stages.online import stage_online
 from vic_drake.reproduce.stages.real_scans import stage_real_scans
 from vic_drake.reproduce.stages.replay import stage_replay
 from vic_drake.reproduce.stages.report import stage_report
@@ -39,6 +40,7 @@ STAGES: tuple[tuple[str, Callable[[RunContext], Any]], ...] = (
     ("scans", stage_scans),
     ("replay", stage_replay),
     ("compare_real", stage_compare_real),
+    ("online", stage_online),
     ("claims", stage_claims),
     ("report", stage_report),
 )
