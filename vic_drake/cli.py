@@ -21,6 +21,7 @@ from vic_drake.paths import check_data_dir
 # Modules under vic_drake.commands, each with register(subparsers).
 COMMAND_MODULES = (
     "offline",
+    "relaxation",
     "mapping",
     "control",
     "scans",

@@ -25,18 +25,20 @@ def test_compare_real_rejects_palpation_bag(data_dir, capsys):
 
 
 @pytest.mark.realdata
-def test_compare_real_unknown_9_column_log_needs_controller(data_dir, tmp_path, capsys):
-    src = data_dir / "experiments" / "test_force_control"
-    dst = tmp_path / "mystery_scan"
-    dst.mkdir()
-    for f in src.iterdir():
-        (dst / f.name.replace("test_force_control", "mystery_scan")).write_bytes(
-            f.read_bytes()
-        )
-    meta = dst / "metadata.yaml"
-    meta.write_text(meta.read_text().replace("test_force_control", "mystery_scan"))
-    assert main(["compare-real", str(dst), "--json"]) == 2
-    assert "--controller" in capsys.readouterr().err
+def test_compare_real_log_whose_signals_cannot_tell_needs_controller(
+    data_dir, tmp_path, capsys
+):
+    # 200 rows (0.4 s) of a CF log: too little contact to tell CS from CF.
+    # The folder name plays no part (a renamed full log is identified).
+    from vic_drake.realdata import read_bag
+    from vic_drake.realdata_write import write_bag
+
+    real = read_bag(data_dir / "experiments" / "test_force_control")
+    bag = write_bag(real.iloc[:200], tmp_path / "scan_log")
+    assert main(["compare-real", str(bag), "--json"]) == 2
+    err = capsys.readouterr().err
+    assert "vic-drake: error: cannot tell the controller" in err
+    assert "--controller" in err and "Traceback" not in err
 
 
 @pytest.mark.realdata

@@ -33,27 +33,41 @@ def test_real_log_scenarios(data_dir):
     cf = read_bag(exp / "test_tracking5")
     assert detect_controller(vf) == "vs-vf" and detect_controller(cf) == "vs-cf"
     s = scenario_from_real_log(vf, name="vf")
-    assert s.controller.reference.controller == "vs-vf"
+    ref = s.controller.reference
+    assert ref.controller == "vs-vf" and "vs-vf (identified" in s.description
     assert s.controller.qp.r_weight == [1e-5] * 3
+    assert ref.eps_d_m == pytest.approx(0.008) and ref.force_min_z_N == -9.0
     assert s.phantom.kind == "measured" and s.trajectory.waypoints
     assert s.controller.tank.initial_energy_J == pytest.approx(0.5, abs=0.01)
     s = scenario_from_real_log(cf, name="cf", r_weight=0.5)
     assert s.controller.reference.force_ref_N == pytest.approx(7.0)
     assert s.controller.qp.r_weight == [0.5] * 3
+    assert "given r_weight = 0.5" in s.description
     profile = fit_target_profile(cf)
     assert profile.scan_speed_m_per_s == pytest.approx(0.01, rel=1e-3)
     assert profile.target_z_m == pytest.approx(0.085, abs=1e-4)
     cs = read_bag(exp / "test_compliance_control400")
-    s = scenario_from_real_log(cs, name="test_compliance_control400")
+    # No name carries the controller: a neutral one gives the same scenario.
+    s = scenario_from_real_log(cs, name="mystery_log")
     assert s.controller.reference.controller == "cs"
-    assert s.controller.reference.constant_stiffness_N_per_m == [400.0] * 3
+    k = s.controller.reference.constant_stiffness_N_per_m
+    assert k == [k[2]] * 3 and k[2] == pytest.approx(400.0, rel=0.1)
+    assert "cs (identified" in s.description
     assert (
         s.trajectory.scan_speed_m_per_s == 0.01 and s.trajectory.liftoff_height_m == 0
     )
-    with pytest.raises(VicDrakeError, match="--controller"):
-        scenario_from_real_log(cs, name="mystery_log")
+    s = scenario_from_real_log(cs, name="x", controller="cs", stiffness_N_per_m=400.0)
+    assert s.controller.reference.constant_stiffness_N_per_m == [400.0] * 3
+    assert "cs (given)" in s.description
+    cf9 = read_bag(exp / "test_force_control")
+    s = scenario_from_real_log(cf9, name="y", controller="cf")
+    assert s.controller.reference.force_ref_N == pytest.approx(7.0, rel=0.05)
     with pytest.raises(VicDrakeError, match="cs or cf"):
         scenario_from_real_log(cs, name="x", controller="vs-vf")
+    short = cs.iloc[:200].copy()
+    short.attrs.update(cs.attrs)
+    with pytest.raises(VicDrakeError, match="--controller cs"):
+        scenario_from_real_log(short, name="short")
 
 
 @pytest.mark.parametrize("gains", [FZI_DEFAULT_FDCC_Z_GAINS, PAPER_FDCC_Z_GAINS])

@@ -67,3 +67,68 @@ def test_palpation_target_switches_to_the_sinusoid():
         PalpationParams(),
     )
     np.testing.assert_array_equal(v_d, 0.0)  # no feed-forward by default
+
+
+def test_relaxing_indentation_ticks_the_exact_update():
+    """One tick moves the branch state by relaxation_step; the force follows it."""
+    from vic_drake.tissue import (
+        DEFAULT_RELAXATION,
+        relaxation_input,
+        relaxation_step,
+        relaxing_hunt_crossley_force,
+    )
+
+    system = HuntCrossleyIndentation(2, BETA, update_period_s=0.002)
+    assert system.n_branches == DEFAULT_RELAXATION.n_branches
+    context = system.CreateDefaultContext()
+    s, kappa, lam = (
+        np.array([0.1, 0.1]),
+        np.array([3000.0, 6000.0]),
+        np.array([2e4, 5e4]),
+    )
+    system.set_tissue(context, surface_z=s, kappa=kappa, lam=lam)
+    q, v = np.array([0.09, 0.095]), np.array([-0.01, 0.0])
+    system.get_indenter_state_input_port().FixValue(context, np.concatenate([q, v]))
+    fresh = system.get_generalized_force_output_port().Eval(context)
+    np.testing.assert_allclose(
+        fresh, hunt_crossley_force(s - q, -v, kappa, lam, BETA), rtol=1e-12
+    )
+    state = np.zeros((2, DEFAULT_RELAXATION.n_branches))
+    for _ in range(50):
+        update = system.EvalUniquePeriodicDiscreteUpdate(context)
+        context.SetDiscreteState(update.get_vector().get_value())
+        state = relaxation_step(
+            state,
+            relaxation_input(s - q, BETA),
+            0.002,
+            DEFAULT_RELAXATION.time_constants_s,
+        )
+    np.testing.assert_allclose(
+        context.get_discrete_state_vector().get_value(), state.ravel(), rtol=1e-12
+    )
+    expected = relaxing_hunt_crossley_force(
+        s - q, -v, kappa, lam, BETA, state, DEFAULT_RELAXATION.fractions
+    )
+    force = system.get_generalized_force_output_port().Eval(context)
+    np.testing.assert_allclose(force, expected, rtol=1e-12)
+    assert np.all(force < fresh)  # The tissue has relaxed.
+    # Switched to plain HC in the context, the state no longer matters.
+    system.set_relaxation(context, None)
+    np.testing.assert_allclose(
+        system.get_generalized_force_output_port().Eval(context), fresh, rtol=1e-12
+    )
+
+
+def test_indentation_relaxation_is_checked_and_optional():
+    from vic_drake.errors import VicDrakeError
+    from vic_drake.tissue import RelaxationParams
+
+    system = HuntCrossleyIndentation(1, BETA)
+    with pytest.raises(VicDrakeError, match="branches"):
+        system.set_relaxation(
+            system.CreateDefaultContext(),
+            RelaxationParams(fractions=(0.1, 0.1), time_constants_s=(1.0, 9.0)),
+        )
+    plain = HuntCrossleyIndentation(1, BETA, relaxation=None)
+    assert plain.n_branches == 0
+    assert plain.CreateDefaultContext().num_discrete_state_groups() == 0

@@ -195,3 +195,46 @@ def test_ports_carry_the_station_signal_names():
     assert system.get_force_output_port().get_name() == "tissue.force_W"
     assert system.get_tip_position_output_port().get_name() == "probe.position"
     assert system.get_tip_velocity_output_port().get_name() == "probe.velocity"
+
+
+def test_relaxing_element_decays_like_the_prony_series():
+    """A held tip: the force relaxes as kappa u G(t) tick by tick; HC without."""
+    from vic_drake.tissue import RelaxationParams
+
+    ph = _plane_phantom(gx=0.0, gy=0.0)
+    relaxation = RelaxationParams(fractions=(0.1, 0.2), time_constants_s=(0.05, 1.0))
+    system = TissueForceElement(
+        ph,
+        indenter_body_index=BodyIndex(1),
+        p_BT=np.array([0.0, 0.0, 0.07]),
+        phantom_body_index=BodyIndex(2),
+        relaxation=relaxation,
+        update_period_s=0.002,
+    )
+    context = system.CreateDefaultContext()
+    X_WB = RigidTransform(RotationMatrix.MakeXRotation(np.pi), [0.0, 0.0, 0.09 + 0.07])
+    system.get_body_poses_input_port().FixValue(
+        context, [RigidTransform(), X_WB, RigidTransform()]
+    )
+    system.get_body_spatial_velocities_input_port().FixValue(
+        context, [SpatialVelocity.Zero()] * 3
+    )
+    hc = float(hunt_crossley_force(0.01, 0.0, 3000.0, 30000.0, 1.35))
+    assert system.get_force_output_port().Eval(context)[2] == pytest.approx(hc)
+    for k in range(1, 501):
+        update = system.EvalUniquePeriodicDiscreteUpdate(context)
+        context.SetDiscreteState(update.get_vector().get_value())
+        if k % 100 == 0:
+            force = system.get_force_output_port().Eval(context)[2]
+            expected = hc * float(relaxation.relaxation_function(k * 0.002))
+            assert force == pytest.approx(expected, rel=1e-12)
+    forces = system.get_spatial_forces_output_port().Eval(context)
+    assert forces[0].F_Bq_W.translational()[2] == pytest.approx(expected, rel=1e-12)
+    plain = TissueForceElement(
+        ph,
+        indenter_body_index=BodyIndex(1),
+        p_BT=np.array([0.0, 0.0, 0.07]),
+        phantom_body_index=BodyIndex(2),
+    )
+    assert plain.get_relaxation_state_index() is None
+    assert plain.CreateDefaultContext().num_discrete_state_groups() == 0

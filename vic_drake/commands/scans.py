@@ -40,13 +40,16 @@ def register(subparsers) -> None:
         "compare-real",
         help="simulate a real scan experiment on the measured map and compare with its log",
         description=(
-            "31-column logs (VS controllers): controller and references from the log "
-            "(VS-CF if F_ref is constant, VS-VF if it varies or F_min reaches -9 N), R "
-            "from --R or 0.1 (VS-CF) / 1e-5 (VS-VF), the logged target as reference. "
-            "9-column logs (CS/CF): --controller (guessed from the folder name "
-            "*compliance_control<K>* / *force_control* otherwise), CS at --stiffness "
-            "(default 400 N/m), CF at --force (default 7 N), the target at the logged "
-            "z_target moving along -x at 1 cm/s from the logged start. *_dist logs: the "
+            "The controller and its settings are identified from the log's signals "
+            "unless given (never from the folder name). 31-column logs (VS "
+            "controllers): VS-CF when F_ref,z is one constant in contact, VS-VF when it "
+            "follows the map law; R read off the logged K_z and confirmed by replaying "
+            "the stiffness QP; the logged target as reference. 9-column logs (CS/CF): "
+            "the contact force regressed on the target-to-tip error, f = K e (CS, its "
+            "stiffness) or f = f_ref (CF, its force); the target at the logged z_target "
+            "moving along -x at 1 cm/s from the logged start. When the signals cannot "
+            "tell, the command stops and asks for --controller and the setting "
+            "(--stiffness, --force, --R). *_dist logs: the "
             "phantom lift is estimated from the log and replayed, and contact losses "
             "are compared. The simulated record is shifted by up to 0.5 s to maximise "
             "the force cross-correlation, then compared over the real log's contact "
@@ -58,16 +61,26 @@ def register(subparsers) -> None:
         "--controller",
         choices=("cs", "cf", "vs-cf", "vs-vf"),
         default=None,
-        help="controller to simulate (default: from the log)",
+        help="controller to simulate (default: identified from the log's signals)",
     )
     p.add_argument(
-        "--stiffness", metavar="N_PER_M", default=None, help="CS stiffness, N/m"
+        "--stiffness",
+        metavar="N_PER_M",
+        default=None,
+        help="CS stiffness, N/m (default: identified from the log)",
     )
     p.add_argument(
-        "--force", metavar="N", default=None, help="CF / VS-CF force reference, N"
+        "--force",
+        metavar="N",
+        default=None,
+        help="CF / VS-CF force reference, N (default: identified from the log)",
     )
     p.add_argument(
-        "--R", dest="r_weight", metavar="R", default=None, help="QP weight R (> 0)"
+        "--R",
+        dest="r_weight",
+        metavar="R",
+        default=None,
+        help="stiffness QP weight R (> 0; default: identified from the log)",
     )
     p.add_argument(
         "--duration",

@@ -24,7 +24,7 @@ from vic_drake.errors import VicDrakeError
 from vic_drake.experiments.campaign_params import CampaignParams
 from vic_drake.experiments.palpation_fit import campaign_lag, fit_point
 from vic_drake.experiments.palpation_sim import SimulatedPalpation, simulate_palpations
-from vic_drake.tissue import Phantom
+from vic_drake.tissue import DEFAULT_RELAXATION, Phantom, RelaxationParams
 
 
 def grid_points(region_m, spacing_m: float) -> tuple[np.ndarray, np.ndarray]:
@@ -47,10 +47,18 @@ def grid_points(region_m, spacing_m: float) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _simulate_batch(args):
-    x, y, s, k, lam, beta, params, seed = args
+    x, y, s, k, lam, beta, params, seed, relaxation = args
     start = time.perf_counter()
     records = simulate_palpations(
-        x, y, surface_z=s, kappa=k, lam=lam, beta=beta, params=params, seed=seed
+        x,
+        y,
+        surface_z=s,
+        kappa=k,
+        lam=lam,
+        beta=beta,
+        params=params,
+        seed=seed,
+        relaxation=relaxation,
     )
     return records, time.perf_counter() - start
 
@@ -103,12 +111,16 @@ def run_campaign(
     *,
     keep_records: bool = False,
     progress=None,
+    relaxation: RelaxationParams | None = DEFAULT_RELAXATION,
 ) -> CampaignResult:
     """Palpates a phantom on a grid and fits every point.
 
     Args:
-        phantom: any :class:`vic_drake.tissue.Phantom` (its beta is used).
+        phantom: any :class:`vic_drake.tissue.Phantom` (its beta is used;
+            its kappa is the tissue's instantaneous modulus).
         params: campaign parameters.
+        relaxation: the simulated tissue's relaxation (None: plain
+            Hunt-Crossley); see :func:`simulate_palpations`.
         keep_records: keep the simulated logs in the result.
         progress: optional callable(str) for progress lines.
 
@@ -136,6 +148,7 @@ def run_campaign(
             beta,
             params,
             params.seed + k,
+            relaxation,
         )
         for k, c in enumerate(chunks)
     ]

@@ -16,6 +16,7 @@ from pydrake.systems.analysis import Simulator
 from vic_drake.errors import VicDrakeError
 from vic_drake.experiments.campaign_params import CampaignParams
 from vic_drake.experiments.indenter_bank import MakeIndenterDiagram
+from vic_drake.tissue import DEFAULT_RELAXATION, RelaxationParams
 
 
 @dataclass(frozen=True)
@@ -42,16 +43,29 @@ class SimulatedPalpation:
 
 
 def simulate_palpations(
-    x, y, *, surface_z, kappa, lam, beta: float, params: CampaignParams, seed: int = 0
+    x,
+    y,
+    *,
+    surface_z,
+    kappa,
+    lam,
+    beta: float,
+    params: CampaignParams,
+    seed: int = 0,
+    relaxation: RelaxationParams | None = DEFAULT_RELAXATION,
 ) -> list[SimulatedPalpation]:
     """Palpates n points at once in one indenter-bank diagram.
 
     Args:
         x, y: (n,) point positions (only recorded).
-        surface_z, kappa, lam: (n,) true tissue under each point.
+        surface_z, kappa, lam: (n,) true tissue under each point (kappa:
+            the instantaneous modulus of a relaxing tissue).
         beta: Hunt-Crossley exponent.
         params: the campaign (palpation, indenter, sensor).
         seed: seed of the sensor noise.
+        relaxation: the tissue's relaxation (:mod:`vic_drake.tissue.relaxation`,
+            with as many branches as :data:`~vic_drake.tissue.DEFAULT_RELAXATION`);
+            None: plain Hunt-Crossley tissue.
     """
     x, y, surface_z, kappa, lam = (
         np.atleast_1d(np.asarray(a, float)) for a in (x, y, surface_z, kappa, lam)
@@ -77,6 +91,9 @@ def simulate_palpations(
         lam=lam,
         start_z=surface_z + pal.start_clearance_m,
         seed=seed,
+    )
+    bank.tissue.set_relaxation(
+        bank.tissue.GetMyMutableContextFromRoot(context), relaxation
     )
     simulator = Simulator(bank.diagram, context)
     # Run the longest allowed approach, then until the last point to touch

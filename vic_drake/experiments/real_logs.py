@@ -2,15 +2,14 @@
 
 :func:`scenario_from_real_log` turns a real bag (``realdata.read_bag``) into
 the :class:`~vic_drake.scenario.Scenario` that replays it on the measured
-map: the controller (:func:`detect_controller`, or guessed from a CS/CF
-log's name), its settings, the FDCC z gains (:func:`identify_fdcc_z_gains`)
-and the target (the logged one as waypoints, or :func:`fit_target_profile`).
-The settings the logs do not hold are the ``DEFAULT_*`` constants below.
+map: the controller and its settings identified from the log's signals
+(:func:`identify_real_log`, :mod:`vic_drake.analysis.controller_id`) unless
+the caller gives them, the FDCC z gains (:func:`identify_fdcc_z_gains`) and
+the target (the logged one as waypoints, or :func:`fit_target_profile`).
 """
 
 from __future__ import annotations
 
-import re
 from dataclasses import replace
 from pathlib import Path
 
@@ -18,9 +17,14 @@ import numpy as np
 import pandas as pd
 
 from vic_drake.analysis.columns import real_to_canonical
+from vic_drake.analysis.controller_id import (
+    SCAN_FORCE_LAG_TICKS,
+    ControllerIdentification,
+    classify_vs_log,
+    identify_controller,
+)
 from vic_drake.analysis.identification import estimate_force_loop_gain
 from vic_drake.errors import VicDrakeError
-from vic_drake.paper import CONTACT_THRESHOLD_N
 from vic_drake.scenario import (
     DisturbanceConfig,
     PhantomConfig,
@@ -28,13 +32,14 @@ from vic_drake.scenario import (
     TrajectoryConfig,
 )
 
-#: Stiffness QP weight R per VS controller when the log does not say, from the
-#: data README: test_tracking5 (VS-CF) ran R = 0.1, test_nardi_matForce_lowR
-#: (VS-VF) R = 1e-5.
+#: The paper's settings of its four controllers (data README): the stiffness
+#: QP weight R of the VS controllers (test_tracking5, VS-CF: 0.1;
+#: test_nardi_matForce_lowR, VS-VF: 1e-5), the CS stiffness (N/m) and the
+#: CF force (N). The synthetic scenarios (paper_scenarios) run them; a real
+#: log's scenario reads its own from the log and uses these only for a CS or
+#: CF controller forced onto a 31-column log, which holds neither setting.
 DEFAULT_R = {"vs-cf": 0.1, "vs-vf": 1e-5}
-#: The CS baseline's stiffness (test_compliance_control400), N/m.
 DEFAULT_CS_STIFFNESS_N_PER_M = 400.0
-#: The CF baseline's force reference (test_force_control), N.
 DEFAULT_CF_FORCE_N = 7.0
 #: FDCC z gains (k_p, k_d): FZI's defaults, which the paper kept for CS "due
 #: to instability problems", and the paper's for the other controllers.
@@ -55,7 +60,7 @@ MODEL_LOOP_GAIN_PER_KP = 0.04
 #: The 9-column CS/CF logs pair each pose with the force read 28 ticks (at
 #: 500 Hz) later (data README); the simulated force is advanced by as much
 #: before the comparison (analysis.real_comparison.lead_force).
-REAL_SCAN_FORCE_DELAY_S = 28 * 0.002
+REAL_SCAN_FORCE_DELAY_S = SCAN_FORCE_LAG_TICKS * 0.002
 #: Period at which a logged target is resampled into scenario waypoints, s.
 #: The real target is piecewise linear with 1 cm/s slopes and one step
 #: (the lift-off); see docs/decisions.md, "Waypoint resampling period".
@@ -63,35 +68,14 @@ WAYPOINT_PERIOD_S = 0.02
 
 
 def detect_controller(real: pd.DataFrame) -> str:
-    """VS-CF or VS-VF from a 31-column log.
+    """VS-CF or VS-VF from a 31-column log's reference laws.
 
-    VS-VF when F_min,z reaches -9 N or F_ref,z varies in contact (more than
-    0.5 N of spread); VS-CF when F_ref,z is constant in contact.
+    See :func:`vic_drake.analysis.controller_id.classify_vs_log`; raises
+    VicDrakeError when the signals cannot tell.
     """
     if real.attrs.get("layout") != "controller":
         raise VicDrakeError("detect_controller needs a 31-column controller log")
-    contact = real["sensor_force_z_N"].to_numpy() < -CONTACT_THRESHOLD_N
-    f_ref = real["force_ref_z_N"].to_numpy()[contact]
-    f_min = real["force_min_z_N"].to_numpy()[contact]
-    if f_ref.size == 0:
-        raise VicDrakeError(
-            "the log never touches the phantom; cannot tell its controller"
-        )
-    if np.any(np.isclose(f_min, -9.0, atol=1e-6)) or np.ptp(f_ref) > 0.5:
-        return "vs-vf"
-    return "vs-cf"
-
-
-def _controller_from_name(name: str) -> tuple[str, float | None] | None:
-    """(controller, setting) guessed from a CS/CF log's folder name, or None."""
-    m = re.search(r"compliance_control(\d+)", name)
-    if m:
-        return "cs", float(m.group(1))
-    if "compliance" in name:
-        return "cs", None
-    if "force_control" in name:
-        return "cf", None
-    return None
+    return classify_vs_log(real)[0]
 
 
 def _resampled_waypoints(real: pd.DataFrame, period_s: float = WAYPOINT_PERIOD_S):
@@ -188,6 +172,41 @@ def identify_fdcc_z_gains(
     return {**out, "gains": tuple(best), "identified": True}
 
 
+def identify_real_log(
+    real: pd.DataFrame,
+    *,
+    controller: str | None = None,
+    stiffness_N_per_m: float | None = None,
+    force_N: float | None = None,
+    r_weight: float | None = None,
+) -> ControllerIdentification:
+    """The controller and settings of a real scan log that the caller left open.
+
+    Runs :func:`vic_drake.analysis.controller_id.identify_controller` for
+    what is not given: the class when ``controller`` is None, then the
+    settings the class needs (R; the VS-CF or CF force; the CS stiffness).
+    R, and a 9-column log's setting, are not identified when given; the
+    caller's settings override the identified ones in the scenario.
+
+    Raises:
+        VicDrakeError: a scan log of another layout, a controller the log
+            cannot hold, or signals that cannot tell (the message names the
+            option to pass).
+    """
+    layout = real.attrs.get("layout")
+    if layout == "scan" and controller not in (None, "cs", "cf"):
+        raise VicDrakeError(
+            "a 9-column log is a CS or CF scan; --controller must be cs or cf, "
+            f"got {controller!r}"
+        )
+    if controller is None:
+        return identify_controller(real, r_weight=r_weight)
+    setting = {"cs": stiffness_N_per_m, "cf": force_N}.get(controller)
+    if layout == "scan" and setting is not None:
+        return ControllerIdentification(controller, given=True)
+    return identify_controller(real, controller=controller, r_weight=r_weight)
+
+
 def scenario_from_real_log(
     real: pd.DataFrame,
     *,
@@ -200,17 +219,23 @@ def scenario_from_real_log(
     base: Scenario | None = None,
     waypoints: bool = True,
     fdcc_z_gains: tuple[float, float] | None = None,
+    identification: ControllerIdentification | None = None,
 ) -> Scenario:
     """The scenario of a real scan on the measured map.
 
-    31-column logs: controller from the log (:func:`detect_controller`) unless
-    given; R from ``r_weight`` or :data:`DEFAULT_R`; VS-CF force reference
-    from the logged F_ref (or ``force_N``); tank starting at the logged
-    energy; the logged target as waypoints; the tip starting at the logged
-    height. 9-column logs: ``controller`` ("cs" or "cf", else guessed from
-    the name) with ``stiffness_N_per_m`` (CS, default 400) or ``force_N``
-    (CF, default 7); the target at z = 0.085 moving along -x at 1 cm/s from
-    the logged start for the log's duration; the tip starting at the logged
+    The controller and the settings the caller does not give (``controller``,
+    ``stiffness_N_per_m`` for CS, ``force_N`` for CF and VS-CF, ``r_weight``
+    for VS) are identified from the log's signals (:func:`identify_real_log`);
+    the description says what was identified and on what evidence.
+
+    31-column logs: VS-CF force reference, VS-VF eps_d and F_min,z, R, and
+    the settings the log holds every tick (K_z bounds, T_min, power limit,
+    eps_max) from the log; tank starting at the logged energy; the logged
+    target as waypoints; the tip starting at the logged height. A CS or CF
+    controller forced onto such a log runs :data:`DEFAULT_CS_STIFFNESS_N_PER_M`
+    or :data:`DEFAULT_CF_FORCE_N` unless given. 9-column logs (CS or CF):
+    the target at the logged z_target moving along -x at 1 cm/s from the
+    logged start for the log's duration; the tip starting at the logged
     pose; the FDCC z gains identified from the log
     (:func:`identify_fdcc_z_gains`; fallback CS :data:`CS_FDCC_Z_GAINS`, CF
     :data:`CF_FDCC_Z_GAINS`) unless ``fdcc_z_gains`` is given.
@@ -222,33 +247,83 @@ def scenario_from_real_log(
         base: scenario to start from (default: ``Scenario()``).
         waypoints: 31-column logs: replay the logged target as waypoints
             (True) or use its parametric fit (:func:`fit_target_profile`).
-    """
+        identification: the result of :func:`identify_real_log` with the
+            same arguments, when the caller already has it.
 
+    Raises:
+        VicDrakeError: see :func:`identify_real_log`.
+    """
     layout = real.attrs.get("layout")
+    if layout not in ("controller", "scan"):
+        raise VicDrakeError(
+            f"log {name!r} has the {layout!r} layout; compare-real needs a scan log "
+            "(31-column controller log or 9-column CS/CF log)"
+        )
+    if identification is None:
+        identification = identify_real_log(
+            real,
+            controller=controller,
+            stiffness_N_per_m=stiffness_N_per_m,
+            force_N=force_N,
+            r_weight=r_weight,
+        )
+    kind = identification.controller
+    found = identification.settings
+    given = []
+
+    def pick(value, key, option, fallback=None):
+        if value is not None:
+            given.append((key, value))
+            return float(value)
+        if key in found:
+            return float(found[key])
+        if fallback is None:
+            raise VicDrakeError(
+                f"the log {name!r} does not give the {kind} controller's {key}; pass "
+                f"{option}"
+            )
+        return float(fallback)
+
     base = base or Scenario()
     duration = float(real["t_s"].iloc[-1])
     ctrl = base.controller
     fdcc = base.fdcc
+    ref = replace(ctrl.reference, controller=kind)
+    if kind == "cs":
+        k = pick(
+            stiffness_N_per_m, "stiffness_N_per_m", "--stiffness N_PER_M",
+            DEFAULT_CS_STIFFNESS_N_PER_M if layout == "controller" else None,
+        )  # fmt: skip
+        ref = replace(ref, constant_stiffness_N_per_m=[k, k, k])
+    elif kind in ("cf", "vs-cf"):
+        fallback = (
+            DEFAULT_CF_FORCE_N if kind == "cf" and layout == "controller" else None
+        )
+        ref = replace(
+            ref, force_ref_N=pick(force_N, "force_ref_N", "--force N", fallback)
+        )
     if layout == "controller":
-        kind = controller or detect_controller(real)
-        if kind not in ("cs", "cf", "vs-cf", "vs-vf"):
-            raise VicDrakeError(
-                f"--controller must be cs, cf, vs-cf or vs-vf; got {kind!r}"
+        if kind == "vs-vf" and "eps_d_m" in found:
+            ref = replace(
+                ref, eps_d_m=found["eps_d_m"], force_min_z_N=found["force_min_z_N"]
             )
-        contact = real["sensor_force_z_N"].to_numpy() < -CONTACT_THRESHOLD_N
-        ref = replace(ctrl.reference, controller=kind)
-        if kind == "vs-cf":
-            logged = -float(np.median(real["force_ref_z_N"].to_numpy()[contact]))
-            ref = replace(ref, force_ref_N=force_N or (logged if logged > 0 else 7.0))
-        elif kind == "cf":
-            ref = replace(ref, force_ref_N=force_N or DEFAULT_CF_FORCE_N)
-        elif kind == "cs":
-            k = stiffness_N_per_m or DEFAULT_CS_STIFFNESS_N_PER_M
-            ref = replace(ref, constant_stiffness_N_per_m=[k, k, k])
-        r = r_weight if r_weight is not None else DEFAULT_R.get(kind, 0.1)
-        qp = replace(ctrl.qp, r_weight=[r, r, r])
+        if "eps_max_m" in found:
+            ref = replace(ref, eps_max_m=found["eps_max_m"])
+        qp = ctrl.qp
+        if kind in ("vs-cf", "vs-vf"):
+            r = pick(r_weight, "r_weight", "--R R")
+            qp = replace(qp, r_weight=[r, r, r])
+        k_lo, k_hi = list(qp.stiffness_min_N_per_m), list(qp.stiffness_max_N_per_m)
+        k_lo[2] = found.get("stiffness_z_min_N_per_m", k_lo[2])
+        k_hi[2] = found.get("stiffness_z_max_N_per_m", k_hi[2])
+        qp = replace(qp, stiffness_min_N_per_m=k_lo, stiffness_max_N_per_m=k_hi)
         t0 = float(real["tank_energy_J"].iloc[0] - real["tank_delta_J"].iloc[0])
-        tank = replace(ctrl.tank, initial_energy_J=t0)
+        tank = replace(
+            ctrl.tank,
+            initial_energy_J=t0,
+            min_energy_J=found.get("tank_min_J", ctrl.tank.min_energy_J),
+            power_limit_W=-found.get("power_limit_W", -ctrl.tank.power_limit_W),
+        )
         ctrl = replace(ctrl, reference=ref, qp=qp, tank=tank)
         if waypoints:
             trajectory = TrajectoryConfig(
@@ -257,41 +332,22 @@ def scenario_from_real_log(
             )
         else:
             trajectory = fit_target_profile(real)
-        description = f"real log {name}: {kind}, R = {r:g}, logged target"
-    elif layout == "scan":
-        guessed = _controller_from_name(name)
-        if controller is None:
-            if guessed is None:
-                raise VicDrakeError(
-                    f"cannot tell the controller of the 9-column log {name!r}; pass "
-                    "--controller cs|cf (with --stiffness N_PER_M or --force N)"
-                )
-            kind = guessed[0]
-        else:
-            kind = controller
-        if kind not in ("cs", "cf"):
-            raise VicDrakeError(
-                f"a 9-column log is a CS or CF scan; --controller must be cs or cf, got {kind!r}"
-            )
-        ref = replace(ctrl.reference, controller=kind)
+        tail = ", logged target"
+    else:
         if kind == "cs":
-            k = stiffness_N_per_m or (guessed[1] if guessed and guessed[1] else None)
-            k = k or DEFAULT_CS_STIFFNESS_N_PER_M
-            ref = replace(ref, constant_stiffness_N_per_m=[k, k, k])
-            k_z, f_ref, fallback = k, 0.0, CS_FDCC_Z_GAINS
-            description = f"real log {name}: CS at {k:g} N/m"
+            k_z, f_ref, fallback = (
+                ref.constant_stiffness_N_per_m[2],
+                0.0,
+                CS_FDCC_Z_GAINS,
+            )
         else:
-            ref = replace(ref, force_ref_N=force_N or DEFAULT_CF_FORCE_N)
             k_z, f_ref, fallback = 0.0, ref.force_ref_N, CF_FDCC_Z_GAINS
-            description = f"real log {name}: CF at {ref.force_ref_N:g} N"
         if fdcc_z_gains is None:
             fdcc_z_gains = identify_fdcc_z_gains(
                 real, stiffness_z_N_per_m=k_z, force_ref_N=f_ref, fallback=fallback
             )["gains"]
         fdcc = with_z_gains(fdcc, *fdcc_z_gains)
-        description += (
-            f", FDCC z gains k_p = {fdcc_z_gains[0]:g}, k_d = {fdcc_z_gains[1]:g}"
-        )
+        tail = f", FDCC z gains k_p = {fdcc_z_gains[0]:g}, k_d = {fdcc_z_gains[1]:g}"
         ctrl = replace(ctrl, reference=ref)
         x0, y0, z0 = (float(real[c].iloc[0]) for c in ("x_m", "y_m", "z_m"))
         z_target = float(real["z_target_m"].iloc[0])
@@ -306,15 +362,13 @@ def scenario_from_real_log(
             liftoff_height_m=0.0,
             initial_tip_z_m=z0,
         )
-    else:
-        raise VicDrakeError(
-            f"log {name!r} has the {layout!r} layout; compare-real needs a scan log "
-            "(31-column controller log or 9-column CS/CF log)"
-        )
+    description = f"real log {name}: {identification.summary()}"
+    if given:
+        description += "; given " + ", ".join(f"{k} = {v:g}" for k, v in given)
     return replace(
         base,
         name=name,
-        description=description,
+        description=description + tail,
         phantom=PhantomConfig(
             kind="measured", lookup="bilinear", controller_lookup="nearest"
         ),
@@ -356,6 +410,7 @@ __all__ = [
     "detect_controller",
     "fit_target_profile",
     "identify_fdcc_z_gains",
+    "identify_real_log",
     "nominal_sibling",
     "scenario_from_real_log",
     "with_z_gains",

@@ -42,7 +42,7 @@ from vic_drake.station.rig import AddRig
 from vic_drake.station.servo import joint_servo_rest_state
 from vic_drake.systems.ft_sensor import ForceTorqueSensor
 from vic_drake.systems.tissue_force import TissueForceElement
-from vic_drake.tissue import Phantom
+from vic_drake.tissue import Phantom, tissue_relaxation
 
 
 def MakeStation(
@@ -94,7 +94,7 @@ def MakeStation(
     builder.ExportInput(rig.position_command, "ur3e.position_command")
     builder.ExportInput(rig.phantom_lift, "phantom.lift")
 
-    # Hunt-Crossley tissue force on the tip.
+    # Hunt-Crossley tissue force on the tip (relaxing unless tissue_law="hc").
     p_IP = np.array([0.0, 0.0, params.indenter_length_m])
     tissue = builder.AddNamedSystem(
         "tissue_force",
@@ -107,6 +107,8 @@ def MakeStation(
             friction_coefficient=params.tissue_friction_coefficient,
             slip_speed_m_per_s=params.tissue_slip_speed_m_per_s,
             along_normal=params.tissue_force_along_normal,
+            relaxation=tissue_relaxation(params.tissue_law),
+            update_period_s=params.plant.time_step,
         ),
     )
     builder.Connect(

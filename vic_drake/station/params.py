@@ -22,6 +22,7 @@ from pydrake.multibody.plant import MultibodyPlantConfig
 
 from vic_drake.errors import VicDrakeError
 from vic_drake.paper import GRAVITY_M_PER_S2
+from vic_drake.tissue.relaxation import TISSUE_LAWS
 
 #: Drake's discrete contact solvers the station supports.
 CONTACT_APPROXIMATIONS = ("sap", "lagged")
@@ -138,6 +139,11 @@ class StationParams:
     # paper's 1-D model); the real scans' lateral forces follow the normal
     # (docs/decisions.md, "Tissue friction and normal").
     tissue_force_along_normal: bool = True
+    # Tissue law of the force element: "relaxing" (Hunt-Crossley whose elastic
+    # term relaxes, vic_drake.tissue.DEFAULT_RELAXATION; the map's kappa is
+    # the instantaneous modulus) or "hc" (plain Hunt-Crossley); see
+    # docs/decisions.md, "Tissue relaxation".
+    tissue_law: str = "relaxing"
     # Grid of the force element's per-step lookup of non-grid phantoms, m
     # (a GridPhantom is looked up on its own grid).
     tissue_lookup_resolution_m: float = 0.0005
@@ -216,6 +222,11 @@ class StationParams:
             raise VicDrakeError(
                 f"StationParams.indenter_tip_radius_m ({self.indenter_tip_radius_m}) must be "
                 f"< indenter_length_m ({self.indenter_length_m})"
+            )
+        if self.tissue_law not in TISSUE_LAWS:
+            raise VicDrakeError(
+                f"StationParams.tissue_law must be one of {TISSUE_LAWS}, got "
+                f"{self.tissue_law!r}"
             )
         for name in ("robot_contact", "tissue_force_along_normal"):
             if not isinstance(getattr(self, name), bool):

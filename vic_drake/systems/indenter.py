@@ -5,9 +5,10 @@ Each indenter is a body on a vertical prismatic joint of a discrete
 towards a desired state (the position servo of the real Cartesian
 controller, with gravity compensated by a feed-forward force). The tissue
 pushes back through :class:`HuntCrossleyIndentation`, a thin LeafSystem
-calling :func:`vic_drake.tissue.hunt_crossley_force` (the same function the
-full robot's force element uses) with each indenter's surface height, kappa,
-lambda and beta. :class:`LaggedForceSensor` samples the force the sensor sees
+calling :func:`vic_drake.tissue.relaxing_hunt_crossley_force` (the law the
+full robot's force element uses: Hunt-Crossley whose elastic term relaxes,
+by default with :data:`vic_drake.tissue.DEFAULT_RELAXATION`) with each
+indenter's surface height, kappa, lambda and beta. :class:`LaggedForceSensor` samples the force the sensor sees
 (tissue force minus the inertia of the indenter below it) at 500 Hz, adds
 Gaussian noise and delays it by a fixed number of samples, as the real F/T
 sensor does. :class:`PalpationTarget` runs the procedure of the real rig:
@@ -33,7 +34,15 @@ from pydrake.systems.framework import BasicVector, LeafSystem
 
 from vic_drake.errors import VicDrakeError
 from vic_drake.paper import CONTACT_THRESHOLD_N
-from vic_drake.tissue import hunt_crossley_force
+from vic_drake.tissue import (
+    DEFAULT_RELAXATION,
+    DEFAULT_UPDATE_PERIOD_S,
+    RelaxationParams,
+    hunt_crossley_force,
+    relaxation_input,
+    relaxation_step,
+    relaxing_hunt_crossley_force,
+)
 
 
 def _check_positive(owner: str, **values) -> None:
@@ -182,24 +191,60 @@ def palpation_target(t, mode, z_start, z_contact, t_contact, params: PalpationPa
 
 
 class HuntCrossleyIndentation(LeafSystem):
-    """Hunt-Crossley tissue force on n vertical indenters.
+    """Hunt-Crossley tissue force on n vertical indenters, optionally relaxing.
 
     Input ``indenter_state`` (2n: heights q in m, velocities v in m/s).
     Output ``generalized_force`` (n, N, positive up): the force applied to
-    each joint, ``hunt_crossley_force(s - q, -v, kappa, lambda, beta,
-    clip_tension=True)``. Numeric parameters (n each): ``surface_z``,
-    ``kappa``, ``lambda`` (set with :meth:`set_tissue`).
+    each joint, ``relaxing_hunt_crossley_force(s - q, -v, kappa, lambda,
+    beta, state, g, clip_tension=True)``
+    (:mod:`vic_drake.tissue.relaxation`; plain Hunt-Crossley when every g
+    is 0). Numeric parameters (n each): ``surface_z``, ``kappa`` (the
+    instantaneous modulus), ``lambda`` (set with :meth:`set_tissue`); and
+    the relaxation's fractions g and time constants tau (K each, set with
+    :meth:`set_relaxation`). Discrete state (n K, updated every
+    ``update_period_s``): the relaxation branch states, m^beta; none when
+    built with ``relaxation=None``.
     """
 
-    def __init__(self, n: int, beta: float):
+    def __init__(
+        self,
+        n: int,
+        beta: float,
+        *,
+        relaxation: RelaxationParams | None = DEFAULT_RELAXATION,
+        update_period_s: float = DEFAULT_UPDATE_PERIOD_S,
+    ):
+        """
+        Args:
+            n: number of indenters.
+            beta: Hunt-Crossley exponent.
+            relaxation: the tissue's relaxation (its branch count K is fixed
+                here; :meth:`set_relaxation` changes the values, g = 0 gives
+                plain HC); None: plain HC without state.
+            update_period_s: period of the branch-state update, s.
+        """
         super().__init__()
-        _check_positive("HuntCrossleyIndentation", beta=beta)
+        _check_positive(
+            "HuntCrossleyIndentation", beta=beta, update_period_s=update_period_s
+        )
         self._n = int(n)
         self._beta = float(beta)
+        self._period = float(update_period_s)
+        self._k = 0 if relaxation is None else relaxation.n_branches
         self._surface_index = self.DeclareNumericParameter(BasicVector(np.zeros(n)))
         self._kappa_index = self.DeclareNumericParameter(BasicVector(np.ones(n)))
         self._lam_index = self.DeclareNumericParameter(BasicVector(np.zeros(n)))
         self._state_port = self.DeclareVectorInputPort("indenter_state", 2 * n)
+        self._branches = None
+        if self._k:
+            self._g_index = self.DeclareNumericParameter(
+                BasicVector(np.asarray(relaxation.fractions))
+            )
+            self._tau_index = self.DeclareNumericParameter(
+                BasicVector(np.asarray(relaxation.time_constants_s))
+            )
+            self._branches = self.DeclareDiscreteState(np.zeros(n * self._k))
+            self.DeclarePeriodicDiscreteUpdateEvent(self._period, 0.0, self._update)
         self._force_port = self.DeclareVectorOutputPort(
             "generalized_force", n, self._calc_force
         )
@@ -214,8 +259,17 @@ class HuntCrossleyIndentation(LeafSystem):
     def beta(self) -> float:
         return self._beta
 
+    @property
+    def n_branches(self) -> int:
+        """K, the relaxation branches per indenter (0: plain HC, no state)."""
+        return self._k
+
     def set_tissue(self, context, *, surface_z, kappa, lam) -> None:
-        """Writes the tissue under each indenter into this system's context."""
+        """Writes the tissue under each indenter into this system's context.
+
+        ``kappa`` is the instantaneous modulus (the relaxed one is
+        ``g_inf kappa``, see :mod:`vic_drake.tissue.relaxation`).
+        """
         for index, value in (
             (self._surface_index, surface_z),
             (self._kappa_index, kappa),
@@ -225,15 +279,66 @@ class HuntCrossleyIndentation(LeafSystem):
                 np.broadcast_to(np.asarray(value, float), (self._n,))
             )
 
-    def _calc_force(self, context, output):
+    def set_relaxation(self, context, relaxation: RelaxationParams | None) -> None:
+        """Sets the relaxation in ``context`` (None: plain HC, g = 0).
+
+        Raises:
+            VicDrakeError: ``relaxation`` has a branch count other than the
+                one this system was built with.
+        """
+        if relaxation is None:
+            if self._k:
+                context.get_mutable_numeric_parameter(self._g_index).SetZero()
+            return
+        if relaxation.n_branches != self._k:
+            raise VicDrakeError(
+                f"HuntCrossleyIndentation was built with {self._k} relaxation "
+                f"branches; got a relaxation with {relaxation.n_branches}"
+            )
+        if self._k:
+            context.get_mutable_numeric_parameter(self._g_index).SetFromVector(
+                np.asarray(relaxation.fractions)
+            )
+            context.get_mutable_numeric_parameter(self._tau_index).SetFromVector(
+                np.asarray(relaxation.time_constants_s)
+            )
+
+    def _inputs(self, context):
         x = self._state_port.Eval(context)
-        q, v = x[: self._n], x[self._n :]
         s = context.get_numeric_parameter(self._surface_index).get_value()
+        return s - x[: self._n], -x[self._n :]
+
+    def _update(self, context, discrete_state):
+        eps, _ = self._inputs(context)
+        tau = context.get_numeric_parameter(self._tau_index).get_value()
+        state = context.get_discrete_state(self._branches).get_value()
+        new = relaxation_step(
+            state.reshape(self._n, self._k),
+            relaxation_input(eps, self._beta),
+            self._period,
+            tau,
+        )
+        discrete_state.get_mutable_vector(self._branches).SetFromVector(new.ravel())
+
+    def _calc_force(self, context, output):
+        eps, eps_dot = self._inputs(context)
         kappa = context.get_numeric_parameter(self._kappa_index).get_value()
         lam = context.get_numeric_parameter(self._lam_index).get_value()
-        output.SetFromVector(
-            hunt_crossley_force(s - q, -v, kappa, lam, self._beta, clip_tension=True)
-        )
+        if self._k:
+            state = (
+                context.get_discrete_state(self._branches)
+                .get_value()
+                .reshape(self._n, self._k)
+            )
+            g = context.get_numeric_parameter(self._g_index).get_value()
+            force = relaxing_hunt_crossley_force(
+                eps, eps_dot, kappa, lam, self._beta, state, g, clip_tension=True
+            )
+        else:
+            force = hunt_crossley_force(
+                eps, eps_dot, kappa, lam, self._beta, clip_tension=True
+            )
+        output.SetFromVector(force)
 
 
 def sensed_force(

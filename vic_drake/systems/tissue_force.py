@@ -18,7 +18,10 @@ Geometry and signs (all in the world frame W = the rig's ``base_link``):
   only, with velocity v_WP):
   ``eps_dot = s_x (xdot_T - xdot_P) + s_y (ydot_T - ydot_P) + zdot_P - zdot_T``.
 - The force magnitude is ``hunt_crossley_force(eps, eps_dot, kappa, lam,
-  beta, clip_tension=True)`` (zero out of contact, never pulling): the
+  beta)`` minus the relaxed part ``kappa sum_i g_i s_i`` of an optional
+  relaxation (:mod:`vic_drake.tissue.relaxation`; the branch states s_i are
+  the element's discrete state, updated each tick), clipped at zero (zero
+  out of contact, never pulling): the
   vertical component of the force on the indenter body at T; the equal and
   opposite force acts on the phantom body at the same point. The map's kappa
   and lambda were fitted to vertical indentations, so the law gives the
@@ -50,7 +53,15 @@ from pydrake.multibody.tree import BodyIndex
 from pydrake.systems.framework import LeafSystem, ValueProducer
 
 from vic_drake.errors import VicDrakeError
-from vic_drake.tissue import Phantom, PointLookup, hunt_crossley_force
+from vic_drake.tissue import (
+    DEFAULT_UPDATE_PERIOD_S,
+    Phantom,
+    PointLookup,
+    RelaxationParams,
+    hunt_crossley_force,
+    relaxation_input,
+    relaxation_step,
+)
 
 
 @dataclass(frozen=True)
@@ -114,6 +125,7 @@ def tip_contact(
     friction_coefficient: float = 0.0,
     slip_speed_m_per_s: float = 0.005,
     along_normal: bool = False,
+    relaxed_m_beta: float = 0.0,
 ) -> TipContact:
     """Hunt-Crossley contact of the probe tip T with a translated phantom Ph.
 
@@ -132,6 +144,9 @@ def tip_contact(
         along_normal: if True the force acts along the surface's (unnormalised)
             normal ``F (-dz/dx, -dz/dy, 1)``, keeping the vertical component
             the fitted law; else it is vertical (the paper's 1-D model).
+        relaxed_m_beta: ``sum_i g_i s_i`` of a relaxing tissue, m^beta
+            (:func:`vic_drake.tissue.relaxing_hunt_crossley_force`; the
+            phantom's kappa is then the instantaneous one); 0: plain HC.
 
     Returns:
         The :class:`TipContact` (see the module docstring for the formulas).
@@ -148,11 +163,8 @@ def tip_contact(
     eps_dot = float(s.dz_dx) * v_rel[0] + float(s.dz_dy) * v_rel[1] - v_rel[2]
     force = 0.0  # out of contact (the law's value too; skips its numpy cost)
     if eps > 0.0:
-        force = float(
-            hunt_crossley_force(
-                eps, eps_dot, s.kappa, s.lam, phantom.beta, clip_tension=True
-            )
-        )
+        force = float(hunt_crossley_force(eps, eps_dot, s.kappa, s.lam, phantom.beta))
+        force = max(force - float(s.kappa) * relaxed_m_beta, 0.0)
     fx = fy = 0.0
     if friction_coefficient > 0.0 and force > 0.0:
         vx, vy = float(v_rel[0]), float(v_rel[1])
@@ -209,8 +221,14 @@ class TissueForceElement(LeafSystem):
             (the probe tip's kinematics, computed here anyway; the station
             exports them under the same names).
 
-    Outputs depend on the plant's state only (no direct feedthrough from
-    the applied-force input), so the loop through the plant is not algebraic.
+    Discrete state (with a relaxation only): the K relaxation branch states,
+    m^beta, updated every ``update_period_s``
+    (:func:`vic_drake.tissue.relaxation_step`, exact for the penetration
+    held over the tick).
+
+    Outputs depend on the plant's state and this state only (no direct
+    feedthrough from the applied-force input), so the loop through the plant
+    is not algebraic.
     """
 
     def __init__(
@@ -224,6 +242,8 @@ class TissueForceElement(LeafSystem):
         friction_coefficient: float = 0.0,
         slip_speed_m_per_s: float = 0.005,
         along_normal: bool = False,
+        relaxation: RelaxationParams | None = None,
+        update_period_s: float = DEFAULT_UPDATE_PERIOD_S,
     ):
         """
         Args:
@@ -237,7 +257,13 @@ class TissueForceElement(LeafSystem):
                 friction (see :func:`tip_contact`); 0 = the paper's model.
             along_normal: force along the surface normal instead of
                 vertical (see :func:`tip_contact`).
+            relaxation: the tissue's stress relaxation
+                (:mod:`vic_drake.tissue.relaxation`; the phantom's kappa is
+                then the instantaneous modulus); None: plain Hunt-Crossley.
+            update_period_s: period of the relaxation state's update, s.
         """
+        if not (np.isfinite(update_period_s) and update_period_s > 0):
+            raise VicDrakeError(f"update_period_s must be > 0, got {update_period_s!r}")
         if not (np.isfinite(friction_coefficient) and friction_coefficient >= 0):
             raise VicDrakeError(
                 f"friction_coefficient must be >= 0, got {friction_coefficient!r}"
@@ -271,6 +297,19 @@ class TissueForceElement(LeafSystem):
         self._velocities_port = self.DeclareAbstractInputPort(
             "body_spatial_velocities", AbstractValue.Make([SpatialVelocity()])
         )
+        # Relaxation: one discrete state vector (the branch states, m^beta),
+        # updated exactly for the penetration held over each tick.
+        self._branches = None
+        prerequisites = {self.all_input_ports_ticket()}
+        if relaxation is not None and relaxation.n_branches:
+            self._g = np.asarray(relaxation.fractions)
+            self._taus = np.asarray(relaxation.time_constants_s)
+            self._period = float(update_period_s)
+            self._branches = self.DeclareDiscreteState(relaxation.n_branches)
+            self.DeclarePeriodicDiscreteUpdateEvent(
+                float(update_period_s), 0.0, self._update_relaxation
+            )
+            prerequisites.add(self.discrete_state_ticket(self._branches))
         model_value = AbstractValue.Make(
             _Cached(
                 TipContact(0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
@@ -285,7 +324,7 @@ class TissueForceElement(LeafSystem):
             value_producer=ValueProducer(
                 allocate=model_value.Clone, calc=self._calc_contact
             ),
-            prerequisites_of_calc={self.all_input_ports_ticket()},
+            prerequisites_of_calc=prerequisites,
         )
         self._forces_port = self.DeclareAbstractOutputPort(
             "spatial_forces",
@@ -356,6 +395,17 @@ class TissueForceElement(LeafSystem):
     def _contact(self, context) -> TipContact:
         return self._contact_cache.Eval(context).contact
 
+    def get_relaxation_state_index(self):
+        """Index of the relaxation branch states (None without relaxation)."""
+        return self._branches
+
+    def _update_relaxation(self, context, discrete_state):
+        u = relaxation_input(self._contact(context).penetration_m, self._phantom.beta)
+        s = context.get_discrete_state(self._branches).get_value()
+        discrete_state.get_mutable_vector(self._branches).SetFromVector(
+            relaxation_step(s, u, self._period, self._taus)
+        )
+
     def _calc_contact(self, context, value):
         poses = self._poses_port.Eval(context)
         velocities = self._velocities_port.Eval(context)
@@ -366,6 +416,11 @@ class TissueForceElement(LeafSystem):
         v_WT = V_WB.translational() + _cross(V_WB.rotational(), p_BT_W)
         p_WPh = poses[self._i_phantom].translation()
         V_WPh = velocities[self._i_phantom]
+        relaxed = 0.0
+        if self._branches is not None:
+            relaxed = float(
+                self._g @ context.get_discrete_state(self._branches).get_value()
+            )
         contact = tip_contact(
             self._phantom,
             p_WT,
@@ -375,6 +430,7 @@ class TissueForceElement(LeafSystem):
             friction_coefficient=self._mu,
             slip_speed_m_per_s=self._slip,
             along_normal=self._along_normal,
+            relaxed_m_beta=relaxed,
         )
         value.set_value(_Cached(contact, p_WT, p_WPh, v_WT, contact.force_W))
 

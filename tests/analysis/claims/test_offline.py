@@ -113,3 +113,19 @@ def test_c2_decay_is_the_fit_fig3_draws():
     d = C.residual_decay(t, r)
     f = fit_exponential(t, r)
     assert (d["a"], d["tau_s"], d["c"]) == (f.a, f.tau_s, f.c)
+
+
+def test_c2_decay_per_log_verdicts():
+    """c2_decay: one verdict per log; the side passes only if every log does."""
+    from vic_drake.analysis.claims.offline import c2_decay
+
+    t = np.linspace(0.5, 20.0, 20)
+    falling = (t, 0.01 + 0.02 * np.exp(-t / 5.0))
+    flat = (t, 0.01 + 1e-4 * np.exp(-t / 0.5))
+    value, passed = c2_decay({"falls": falling, "flat": flat})
+    assert value["falls"]["pass"] is True and value["flat"]["pass"] is False
+    assert passed is False
+    assert c2_decay({"falls": falling})[1] is True
+    assert c2_decay(None) == (None, None)
+    single, ok = c2_decay(falling)
+    assert ok is True and "pass" not in single

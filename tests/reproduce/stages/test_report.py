@@ -28,15 +28,27 @@ def test_notes_of_a_run_without_real_data(tmp_path, monkeypatch):
         "5 cm",
     ):
         assert stale not in text, stale
-    assert "0.97 of the shortest one's" in text
+    assert "fails on this run's relaxing tissue: ratio 0.97" in text
+    # The plain-HC control run is reported when the stage made one.
+    assert "Control run" not in text
+    ctx.results["offline_sim"] = {
+        "truth": {"relaxation": {"fractions": [0.08], "time_constants_s": [22.9]}},
+        "control_hc": {
+            "c2": {"sim_2.5hz": {"ratio_last_first": 0.97}},
+            "c2_pass": False,
+        },
+    }
+    text = " ".join(report_notes(ctx, claims))
+    assert "g = 0.080, tau = 22.9 s" in text
+    assert "Control run" in text and "C2 fails" in text and "0.97" in text
 
 
 def test_notes_with_real_logs_and_a_passing_c2(tmp_path, monkeypatch):
     ctx = _ctx(tmp_path, monkeypatch, ["offline_sim", "offline_real", "real_scans"])
     claims = {"C2": {"sim": {"ratio_last_first": 0.3}, "pass_sim": True}}
     text = " ".join(report_notes(ctx, claims))
-    assert "the real logs test that" in text
-    assert "C2 in simulation:" not in text and "C4-C7" not in text
+    assert "the real logs test it" in text
+    assert "fails on this run's" not in text and "C4-C7" not in text
 
 
 def test_versions_from_installed_metadata():

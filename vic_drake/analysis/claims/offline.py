@@ -157,6 +157,29 @@ def _c2_pass(d: dict) -> bool:
     )
 
 
+def c2_decay(curves) -> tuple:
+    """C2's metric and verdict on one side's residual curves.
+
+    Args:
+        curves: (duration_s, residual) arrays, or {log name: (duration_s,
+            residual)} (each log must pass), or None.
+
+    Returns:
+        (value, passed): :func:`residual_decay`'s dict (per log, each with
+        its own ``pass``, for a mapping) and whether C2 holds; (None, None)
+        for None.
+    """
+    if curves is None:
+        return None, None
+    if not isinstance(curves, Mapping):
+        d = residual_decay(*curves)
+        return d, _c2_pass(d)
+    per_log = {name: residual_decay(*c) for name, c in curves.items()}
+    for d in per_log.values():
+        d["pass"] = _c2_pass(d)
+    return per_log, all(d["pass"] for d in per_log.values())
+
+
 def claim_c2(
     sim: tuple | None,
     real: tuple | None,
@@ -174,19 +197,8 @@ def claim_c2(
     R^2 >= 0.9 with a positive amplitude.
     """
 
-    def side(curves):
-        if curves is None:
-            return None, None
-        if not isinstance(curves, Mapping):
-            d = residual_decay(*curves)
-            return d, _c2_pass(d)
-        per_log = {name: residual_decay(*c) for name, c in curves.items()}
-        for d in per_log.values():
-            d["pass"] = _c2_pass(d)
-        return per_log, all(d["pass"] for d in per_log.values())
-
-    sv, sp = side(sim)
-    rv, rp = side(real)
+    sv, sp = c2_decay(sim)
+    rv, rp = c2_decay(real)
     detail = (
         f"fit r(T)=c+a exp(-T/tau); pass: spearman <= {C2_MAX_SPEARMAN}, "
         f"R^2 >= {C2_MIN_R2}, a > 0, r(T_max)/r(T_min) <= {C2_MAX_RATIO} (every log)"
