@@ -11,6 +11,7 @@ from vic_drake.analysis.identification import (
     lift_table,
 )
 from vic_drake.errors import VicDrakeError
+from vic_drake.tissue import hunt_crossley_force
 from vic_drake.tissue.phantom import GridPhantom
 
 
@@ -30,12 +31,14 @@ def test_lift_estimate_recovers_a_lift_on_a_flat_phantom():
     lift = 0.015 * np.clip(np.minimum(t - 5, 9 - t), 0, 1)  # Trapezoid 5-10 s.
     z = 0.095 + 0.5 * lift  # The robot is pushed up by half the lift.
     eps = 0.1 + lift - z
-    f = 4000 * eps**1.35
+    f = hunt_crossley_force(eps, np.gradient(eps, t), 4000, 40000, 1.35)
     df = make_scan(t, f, x_m=0.03 - 0.01 * t, y_m=-0.36, z_m=z)
-    est = estimate_phantom_lift(df, phantom, smooth_s=0.05)
-    np.testing.assert_allclose(est["phantom_lift_m"], lift, atol=2e-4)
+    est = estimate_phantom_lift(df, phantom)
+    assert list(est.columns) == ["t_s", "phantom_lift_m", "measured"]
+    # Within 0.5 mm at the kinks of the trapezoid (the viscous rate is smoothed).
+    np.testing.assert_allclose(est["phantom_lift_m"], lift, atol=5e-4)
     table = lift_table(est, dt_s=0.1)
-    assert len(table) == 200 and table[60][1] == pytest.approx(0.015, abs=3e-4)
+    assert len(table) == 200 and table[70][1] == pytest.approx(0.015, abs=3e-4)
 
 
 def test_force_loop_gain_recovers_a_known_integral_loop():

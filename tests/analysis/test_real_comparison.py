@@ -5,6 +5,7 @@ import pytest
 
 from tests.analysis.scans import make_scan
 from vic_drake.analysis.real_comparison import (
+    compare_contact_loss,
     compare_with_real,
     estimate_time_offset_s,
     lead_force,
@@ -43,3 +44,21 @@ def test_compare_identical_records_is_perfect():
     assert out["z_rmse_mm"] == pytest.approx(0.0, abs=1e-12)
     assert out["kz_corr"] == pytest.approx(1.0)
     assert out["time_offset_s"] == 0.0
+
+
+def test_contact_loss_comparison_counts_totals_and_overlap():
+    t = np.arange(0, 10, 0.002)
+    real_f = np.where((t > 3) & (t < 4), 0.0, 6.0)
+    sim_f = np.where((t > 3.5) & (t < 4.2), 0.0, 6.0)
+    out = compare_contact_loss(make_scan(t, sim_f), make_scan(t, real_f))
+    assert out["contact_loss_total_real_s"] == pytest.approx(1.0, abs=0.005)
+    assert out["contact_loss_total_sim_s"] == pytest.approx(0.7, abs=0.005)
+    assert out["contact_loss_overlap_s"] == pytest.approx(0.5, abs=0.005)
+    # No loss in either run: the figures are 0.0, not missing.
+    none = compare_contact_loss(
+        make_scan(t, np.full_like(t, 6.0)), make_scan(t, np.full_like(t, 6.0))
+    )
+    assert none["contact_loss_total_sim_s"] == 0.0
+    assert none["contact_loss_total_real_s"] == 0.0
+    assert none["contact_loss_overlap_s"] == 0.0
+    assert none["contact_loss_real_s"] == []

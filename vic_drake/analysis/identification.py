@@ -1,5 +1,6 @@
 """Identification from scan logs: the FDCC force-loop gain, the tissue's
-lateral friction and normal tilt, and the phantom's lift under a disturbance.
+lateral friction and normal tilt, and the phantom's lift under a disturbance
+(:mod:`vic_drake.analysis.phantom_motion`).
 """
 
 import numpy as np
@@ -8,8 +9,14 @@ from scipy.signal import savgol_filter
 
 from vic_drake.analysis.columns import require_columns
 from vic_drake.analysis.contact import contact_mask, pressing_force_N
-from vic_drake.errors import VicDrakeError
-from vic_drake.paper import CONTACT_THRESHOLD_N
+from vic_drake.analysis.phantom_motion import estimate_phantom_motion, lift_table
+
+__all__ = [
+    "estimate_force_loop_gain",
+    "estimate_phantom_lift",
+    "estimate_tissue_friction",
+    "lift_table",
+]
 
 
 def _smoothed_rate(t: np.ndarray, v: np.ndarray, smooth_s: float) -> np.ndarray:
@@ -161,24 +168,6 @@ def estimate_tissue_friction(
     }
 
 
-def apparent_surface_z_m(df: pd.DataFrame, phantom) -> np.ndarray:
-    """Surface height implied by the tip height and the pressing force, m.
-
-    Inverts the static Hunt-Crossley law F = kappa eps^beta with kappa of the
-    phantom map at the tip's (x, y): surface = z + (F / kappa)^(1 / beta).
-    NaN out of contact (no force, no information on the surface). The
-    viscous term is neglected: at the logs' penetration rates (|eps_dot| <
-    3 cm/s) it changes eps by under 1 mm on soft tissue.
-    """
-    f = pressing_force_N(df)
-    x, y = df["x_m"].to_numpy(float), df["y_m"].to_numpy(float)
-    kappa = np.asarray(phantom.kappa(x, y), float)
-    eps = np.where(f > CONTACT_THRESHOLD_N, np.maximum(f, 0.0) / kappa, np.nan) ** (
-        1.0 / phantom.beta
-    )
-    return df["z_m"].to_numpy(float) + eps
-
-
 def estimate_phantom_lift(
     dist: pd.DataFrame,
     phantom,
@@ -187,59 +176,12 @@ def estimate_phantom_lift(
     smooth_s: float = 0.2,
     baseline_s: float = 1.0,
 ) -> pd.DataFrame:
-    """Estimates the phantom's z offset over time from a real ``_dist`` log.
+    """The phantom's vertical motion of a scan (t_s, phantom_lift_m, measured).
 
-    Method: the apparent surface under the probe (:func:`apparent_surface_z_m`,
-    tip height + static Hunt-Crossley penetration for the measured force) is
-    compared with the undisturbed surface at the same x: the apparent surface
-    of the matching nominal log when given (which cancels the map's own
-    errors and the rig's constant offsets), else the phantom map's surface.
-    The difference is smoothed with a centred moving average of smooth_s,
-    its median over the first baseline_s is removed (the phantom is assumed
-    at rest at the start), and contact-loss gaps (no force, no information)
-    are bridged linearly. Assumes the phantom moves rigidly and vertically
-    and keeps its map (kappa) under the probe.
-
-    Returns:
-        DataFrame with t_s, phantom_lift_m, and measured (bool: from contact,
-        False where bridged).
+    The columns of :func:`vic_drake.analysis.phantom_motion.estimate_phantom_motion`
+    without its uncertainty; see there for the method.
     """
-    require_columns(dist, "t_s", "x_m", "y_m", "z_m", "force_sensor_z_N")
-    s_dist = apparent_surface_z_m(dist, phantom)
-    x = dist["x_m"].to_numpy(float)
-    if nominal is not None:
-        s_nom = apparent_surface_z_m(nominal, phantom)
-        xn = nominal["x_m"].to_numpy(float)
-        ok = np.isfinite(s_nom)
-        order = np.argsort(xn[ok])
-        ref = np.interp(x, xn[ok][order], s_nom[ok][order])
-    else:
-        ref = np.asarray(phantom.surface_z(x, dist["y_m"].to_numpy(float)), float)
-    raw = s_dist - ref
-    t = dist["t_s"].to_numpy(float)
-    dt = float(np.median(np.diff(t)))
-    n = max(1, int(round(smooth_s / dt)))
-    measured = np.isfinite(raw)
-    if measured.sum() < 2:
-        raise VicDrakeError(
-            "the disturbance log has no contact; cannot estimate a lift"
-        )
-    filled = np.interp(t, t[measured], raw[measured])
-    kernel = np.ones(n) / n
-    smooth = np.convolve(
-        np.pad(filled, (n // 2, n - 1 - n // 2), mode="edge"), kernel, "valid"
+    motion = estimate_phantom_motion(
+        dist, phantom, nominal=nominal, smooth_s=smooth_s, baseline_s=baseline_s
     )
-    base_sel = measured & (t <= t[0] + baseline_s)
-    base = float(np.median(smooth[base_sel])) if base_sel.any() else 0.0
-    return pd.DataFrame(
-        {"t_s": t, "phantom_lift_m": smooth - base, "measured": measured}
-    )
-
-
-def lift_table(lift: pd.DataFrame, *, dt_s: float = 0.05) -> list[list[float]]:
-    """Resamples an estimated lift to a [t_s, z_offset_m] table for the scenario."""
-    t = lift["t_s"].to_numpy(float)
-    grid = np.arange(t[0], t[-1] + 1e-9, dt_s)
-    z = np.interp(grid, t, lift["phantom_lift_m"].to_numpy(float))
-    z = np.clip(z, -0.1, 0.1)
-    return [[float(a), float(b)] for a, b in zip(grid, z)]
+    return motion[["t_s", "phantom_lift_m", "measured"]]

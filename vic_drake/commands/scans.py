@@ -89,6 +89,13 @@ def register(subparsers) -> None:
         help="simulate only the first S seconds",
     )
     p.add_argument(
+        "--tissue-law",
+        choices=("relaxing", "hc"),
+        default=None,
+        help="the simulated tissue: Hunt-Crossley with stress relaxation (default) "
+        "or plain Hunt-Crossley",
+    )
+    p.add_argument(
         "--plot", metavar="PNG", default=None, help="save a sim-vs-real figure"
     )
     p.add_argument(
@@ -161,6 +168,7 @@ def run_compare_real(args: argparse.Namespace) -> int:
         r_weight=r,
         data_dir=args.data_dir,
         duration_s=duration,
+        tissue_law=args.tissue_law,
         progress=progress,
         return_frames=True,
     )

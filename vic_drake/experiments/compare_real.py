@@ -1,33 +1,68 @@
 """A real scan replayed in simulation and compared with its log.
 
 :func:`compare_real` builds the scenario of a real bag
-(:func:`~vic_drake.experiments.real_logs.scenario_from_real_log`), replays
-the estimated phantom lift of a ``*_dist`` log, simulates it
-(:func:`~vic_drake.experiments.scan_run.run_scan`) and reduces both runs to
-the same metrics; ``vic-drake compare-real`` is a thin wrapper around it.
+(:func:`~vic_drake.experiments.real_logs.scenario_from_real_log`), estimates
+the phantom's motion from the log and replays it when it is significant
+(:func:`~vic_drake.analysis.phantom_motion.motion_is_significant`), simulates
+it (:func:`~vic_drake.experiments.scan_run.run_scan`) and reduces both runs
+to the same metrics; ``vic-drake compare-real`` is a thin wrapper around it.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+
 from vic_drake.analysis.columns import real_to_canonical
-from vic_drake.analysis.identification import (
-    estimate_force_loop_gain,
-    estimate_phantom_lift,
-    lift_table,
+from vic_drake.analysis.identification import estimate_force_loop_gain
+from vic_drake.analysis.phantom_motion import (
+    estimate_phantom_motion,
+    map_surface_error_m,
+    motion_significance,
+    replay_table,
 )
 from vic_drake.analysis.real_comparison import compare_contact_loss, compare_with_real
 from vic_drake.errors import VicDrakeError
 from vic_drake.experiments.real_logs import (
     REAL_SCAN_FORCE_DELAY_S,
+    identify_real_log,
     nominal_sibling,
     scenario_from_real_log,
 )
 from vic_drake.experiments.scan_run import run_scan
 from vic_drake.realdata import read_bag
 from vic_drake.scenario import DisturbanceConfig
+from vic_drake.tissue import TISSUE_LAWS
 from vic_drake.tissue.phantom import load_phantom
+
+
+def phantom_replay(bag: Path, real, phantom):
+    """The phantom's motion in a real scan and the table that replays it.
+
+    The motion (:func:`~vic_drake.analysis.phantom_motion.estimate_phantom_motion`)
+    is estimated against the nominal sibling log when one exists
+    (:func:`~vic_drake.experiments.real_logs.nominal_sibling`), else the map;
+    the table (:func:`~vic_drake.analysis.phantom_motion.replay_table`) is
+    empty unless the motion is significant, and with a sibling it carries the
+    map's surface error under the track that the sibling measures.
+
+    Args:
+        bag: the log's folder.
+        real: its canonical frame (``real_to_canonical``).
+        phantom: the measured map.
+
+    Returns:
+        (motion DataFrame, table ``[[t_s, z_offset_m], ...]`` or ``[]``,
+        map surface error per sample in m or None without a sibling).
+    """
+    sibling = nominal_sibling(Path(bag))
+    nominal = real_to_canonical(read_bag(sibling)) if sibling else None
+    motion = estimate_phantom_motion(real, phantom, nominal=nominal)
+    surface_error = (
+        map_surface_error_m(real, phantom, nominal) if nominal is not None else None
+    )
+    return motion, replay_table(motion, surface_error_m=surface_error), surface_error
 
 
 def compare_real(
@@ -39,21 +74,35 @@ def compare_real(
     r_weight: float | None = None,
     data_dir=None,
     duration_s: float | None = None,
+    tissue_law: str | None = None,
     progress=None,
     return_frames: bool = False,
 ):
     """Simulates a real experiment on the measured map and compares it with its log.
 
-    See :func:`scenario_from_real_log` for how the scenario is built. For a
-    ``*_dist`` log the phantom lift is estimated from the log
-    (:func:`vic_drake.analysis.identification.estimate_phantom_lift`, against the nominal
-    sibling log when it exists) and replayed; contact losses are compared.
+    See :func:`scenario_from_real_log` for how the scenario is built. The
+    phantom's motion is estimated from every log
+    (:func:`vic_drake.analysis.phantom_motion.estimate_phantom_motion`,
+    against the nominal sibling log when it exists, else the map) and
+    replayed as the scenario's disturbance table when it is significant
+    (:func:`vic_drake.analysis.phantom_motion.replay_table`; with a sibling,
+    plus the map's surface error under the track that the sibling measures,
+    :func:`vic_drake.analysis.phantom_motion.map_surface_error_m`);
+    contact losses of both runs are compared.
     Alignment: :func:`vic_drake.analysis.real_comparison.compare_with_real`.
 
     Returns:
         dict with the contract keys controller, duration_s, force_rmse_N,
         force_peak_err_N, z_rmse_mm, kz_corr, tank_min_J, rtf, and more
-        (time offset, window, peaks, means, lift and contact-loss figures).
+        (time offset, window, peaks, means, the motion's figures
+        ``phantom_motion_*``; ``lift_*`` when replayed (``lift_max_mm``: the
+        replayed table's highest offset); ``map_surface_error_max_mm`` with a
+        sibling; and the contact-loss
+        figures of :func:`vic_drake.analysis.real_comparison.compare_contact_loss`).
+        ``controller_identified`` holds what was identified from the log
+        (:func:`~vic_drake.experiments.real_logs.identify_real_log`) and
+        ``tissue_law`` the simulated tissue's law ("relaxing" unless
+        ``tissue_law`` says "hc").
         With ``return_frames``: (dict, sim DataFrame, real canonical DataFrame).
     """
     bag = Path(bag_dir)
@@ -68,20 +117,41 @@ def compare_real(
             f"({raw.shape[1]} columns); compare-real needs a scan log: 31 columns "
             "(VS controller) or 9 columns (CS/CF)"
         )
+    if tissue_law is not None and tissue_law not in TISSUE_LAWS:
+        raise VicDrakeError(
+            f"tissue_law must be one of {list(TISSUE_LAWS)}; got {tissue_law!r}"
+        )
+    # The controller first: a log whose signals cannot tell fails before the
+    # motion estimate and the simulation.
+    identification = identify_real_log(
+        raw,
+        controller=controller,
+        stiffness_N_per_m=stiffness_N_per_m,
+        force_N=force_N,
+        r_weight=r_weight,
+    )
     real = real_to_canonical(raw)
     phantom = load_phantom("measured", data_dir=data_dir, lookup="bilinear")
-    disturbance = None
-    lift_info = {}
-    is_dist = bag.name.endswith("_dist")
-    if is_dist:
-        sibling = nominal_sibling(bag)
-        nominal = real_to_canonical(read_bag(sibling)) if sibling else None
-        lift = estimate_phantom_lift(real, phantom, nominal=nominal)
-        disturbance = DisturbanceConfig(table=lift_table(lift))
-        lift_info = {
-            "lift_max_mm": float(1e3 * lift["phantom_lift_m"].max()),
-            "lift_reference": "nominal log" if sibling else "phantom map",
-        }
+    motion, table, surface_error = phantom_replay(bag, real, phantom)
+    replay = bool(table)
+    disturbance = DisturbanceConfig(table=table) if replay else None
+    lift_m = motion["phantom_lift_m"].to_numpy()
+    motion_info = {
+        "phantom_motion_max_mm": float(1e3 * np.max(np.abs(lift_m))),
+        "phantom_motion_sigma_median_mm": float(
+            1e3 * np.median(motion["phantom_lift_sigma_m"])
+        ),
+        "phantom_motion_significance": motion_significance(motion),
+        "phantom_motion_replayed": bool(replay),
+        "phantom_motion_reference": motion.attrs["reference"],
+    }
+    if replay:
+        motion_info["lift_max_mm"] = float(1e3 * max(row[1] for row in table))
+        motion_info["lift_reference"] = motion.attrs["reference"]
+    if surface_error is not None:
+        motion_info["map_surface_error_max_mm"] = float(
+            1e3 * np.max(np.abs(surface_error))
+        )
     scenario = scenario_from_real_log(
         raw,
         name=bag.name,
@@ -90,7 +160,11 @@ def compare_real(
         force_N=force_N,
         r_weight=r_weight,
         disturbance=disturbance,
+        identification=identification,
     )
+    if tissue_law is not None:
+        scenario.station.tissue_law = tissue_law
+        scenario.validate()
     if progress:
         progress(scenario.description)
     result = run_scan(
@@ -136,13 +210,14 @@ def compare_real(
         )
         out[f"force_loop_gain_{label}"] = est["gain_m_per_s_per_N"]
     out["fdcc_z_gains"] = [scenario.fdcc.p_gains[2], scenario.fdcc.d_gains[2]]
-    if is_dist:
-        out.update(lift_info)
-        seen = real[real["t_s"] <= result.df["t_s"].iloc[-1] + metrics["time_offset_s"]]
-        out.update(compare_contact_loss(result.df, seen))
+    out.update(motion_info)
+    out["controller_identified"] = identification.as_dict()
+    out["tissue_law"] = scenario.station.tissue_law
+    seen = real[real["t_s"] <= result.df["t_s"].iloc[-1] + metrics["time_offset_s"]]
+    out.update(compare_contact_loss(result.df, seen))
     if return_frames:
         return out, result.df, real
     return out
 
 
-__all__ = ["compare_real"]
+__all__ = ["compare_real", "phantom_replay"]

@@ -13,16 +13,15 @@ from dataclasses import replace
 from pathlib import Path
 
 from vic_drake.analysis.columns import real_to_canonical
-from vic_drake.analysis.identification import estimate_phantom_lift, lift_table
 from vic_drake.control.params import ReferenceParams
 from vic_drake.errors import VicDrakeError
+from vic_drake.experiments.compare_real import phantom_replay
 from vic_drake.experiments.real_logs import (
     CF_FDCC_Z_GAINS,
     CS_FDCC_Z_GAINS,
     DEFAULT_CF_FORCE_N,
     DEFAULT_CS_STIFFNESS_N_PER_M,
     DEFAULT_R,
-    nominal_sibling,
     scenario_from_real_log,
     with_z_gains,
 )
@@ -150,19 +149,16 @@ def real_experiment_scenario(
 ) -> Scenario:
     """The scenario of one of the paper's scan logs on the measured map.
 
-    As compare-real builds it (:func:`scenario_from_real_log`, lift table
-    estimated for ``*_dist`` logs), with the parametric target fit by
-    default so the scenario file stays short.
+    As compare-real builds it (:func:`scenario_from_real_log`; the phantom's
+    motion replayed where the log shows it,
+    :func:`~vic_drake.experiments.compare_real.phantom_replay`), with the
+    parametric target fit by default so the scenario file stays short.
     """
     bag = require_data_dir(data_dir) / "experiments" / name
     raw = read_bag(bag)
-    disturbance = None
-    if name.endswith("_dist"):
-        phantom = load_phantom("measured", data_dir=data_dir)
-        sibling = nominal_sibling(bag)
-        nominal = real_to_canonical(read_bag(sibling)) if sibling else None
-        lift = estimate_phantom_lift(real_to_canonical(raw), phantom, nominal=nominal)
-        disturbance = DisturbanceConfig(table=lift_table(lift))
+    phantom = load_phantom("measured", data_dir=data_dir, lookup="bilinear")
+    _, table, _ = phantom_replay(bag, real_to_canonical(raw), phantom)
+    disturbance = DisturbanceConfig(table=table) if table else None
     return scenario_from_real_log(
         raw, name=name, disturbance=disturbance, waypoints=waypoints
     )

@@ -132,24 +132,30 @@ def fit_target_profile(real: pd.DataFrame) -> TrajectoryConfig:
 def identify_fdcc_z_gains(
     real: pd.DataFrame,
     *,
-    stiffness_z_N_per_m: float,
+    stiffness_z_N_per_m: float | None,
     force_ref_N: float,
     fallback: tuple[float, float],
 ) -> dict:
-    """The FDCC z gains a 9-column CS/CF log ran with, from its loop gain.
+    """The FDCC z gains a real scan log ran with, from its loop gain.
 
     The loop gain G is identified from the log
-    (:func:`vic_drake.analysis.identification.estimate_force_loop_gain`, with the run's K_z
-    and pressing-force reference) and the rig's two documented gain sets,
-    :data:`FZI_DEFAULT_FDCC_Z_GAINS` and :data:`PAPER_FDCC_Z_GAINS`, are
-    scored by ``|log(G / (MODEL_LOOP_GAIN_PER_KP k_p))|``; the nearer wins.
-    When the identification is weak (R^2 < 0.5, G <= 0, too little contact)
-    ``fallback`` is used.
+    (:func:`vic_drake.analysis.identification.estimate_force_loop_gain`, with
+    the run's K_z and the force reference that FDCC tracks). 9-column CS/CF
+    logs: the rig's two documented gain sets, :data:`FZI_DEFAULT_FDCC_Z_GAINS`
+    and :data:`PAPER_FDCC_Z_GAINS`, are scored by
+    ``|log(G / (MODEL_LOOP_GAIN_PER_KP k_p))|``; the nearer wins. 31-column
+    VS logs: neither set is near (docs/decisions.md, "FDCC z gains of the VS
+    logs"), so ``k_p = G / MODEL_LOOP_GAIN_PER_KP`` with ``k_d`` in the
+    fallback's ratio to ``k_p``. When the identification is weak (R^2 < 0.5,
+    G <= 0, too little contact, or k_p outside [0.02, 1]) ``fallback`` is
+    used.
 
     Args:
-        real: ``realdata.read_bag`` of a 9-column log.
-        stiffness_z_N_per_m: the run's K_z (CS: its stiffness; CF: 0).
-        force_ref_N: the run's pressing-force reference, N (CS: 0).
+        real: ``realdata.read_bag`` of the log.
+        stiffness_z_N_per_m: the run's K_z (CS: its stiffness; CF: 0); None
+            for a 31-column log (its logged K_z).
+        force_ref_N: the pressing-force reference FDCC tracks, N (CS and the
+            VS controllers, whose force enters through K_z: 0).
         fallback: (k_p, k_d) used without a usable identification.
 
     Returns:
@@ -165,6 +171,12 @@ def identify_fdcc_z_gains(
     out = {"gain_m_per_s_per_N": g, "r2": r2}
     if not (np.isfinite(g) and g > 0 and r2 >= 0.5):
         return {**out, "gains": tuple(fallback), "identified": False}
+    if real.attrs.get("layout") == "controller":
+        k_p = g / MODEL_LOOP_GAIN_PER_KP
+        if not 0.02 <= k_p <= 1.0:
+            return {**out, "gains": tuple(fallback), "identified": False}
+        k_d = k_p * fallback[1] / fallback[0]
+        return {**out, "gains": (float(k_p), float(k_d)), "identified": True}
     sets = (FZI_DEFAULT_FDCC_Z_GAINS, PAPER_FDCC_Z_GAINS)
     best = min(
         sets, key=lambda kp_kd: abs(np.log(g / (MODEL_LOOP_GAIN_PER_KP * kp_kd[0])))
@@ -325,6 +337,14 @@ def scenario_from_real_log(
             power_limit_W=-found.get("power_limit_W", -ctrl.tank.power_limit_W),
         )
         ctrl = replace(ctrl, reference=ref, qp=qp, tank=tank)
+        if fdcc_z_gains is None:
+            fdcc_z_gains = identify_fdcc_z_gains(
+                real,
+                stiffness_z_N_per_m=None,
+                force_ref_N=0.0,
+                fallback=PAPER_FDCC_Z_GAINS,
+            )["gains"]
+        fdcc = with_z_gains(fdcc, *fdcc_z_gains)
         if waypoints:
             trajectory = TrajectoryConfig(
                 waypoints=_resampled_waypoints(real),
@@ -332,7 +352,10 @@ def scenario_from_real_log(
             )
         else:
             trajectory = fit_target_profile(real)
-        tail = ", logged target"
+        tail = (
+            f", logged target, FDCC z gains k_p = {fdcc_z_gains[0]:.3g}, "
+            f"k_d = {fdcc_z_gains[1]:.3g}"
+        )
     else:
         if kind == "cs":
             k_z, f_ref, fallback = (

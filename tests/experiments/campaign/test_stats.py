@@ -23,6 +23,9 @@ def test_wilson_interval_closed_form_and_edges():
     lo, hi = wilson_interval(50, 100)  # Symmetric about 1/2.
     assert lo + hi == pytest.approx(1.0) and hi - lo == pytest.approx(0.1922, abs=1e-3)
     assert all(math.isnan(v) for v in wilson_interval(0, 0))
+    # Exact ends for every n (n = 12 left a 3e-17 residue).
+    for n in range(1, 200):
+        assert wilson_interval(0, n)[0] == 0.0 and wilson_interval(n, n)[1] == 1.0
 
 
 def _rows():

@@ -25,7 +25,8 @@ def stage_compare_real(ctx: RunContext) -> dict:
     """Each real scan re-run in simulation on the measured map, compared with its log.
 
     :func:`vic_drake.experiments.compare_real` (logged target, controller
-    settings, estimated phantom lift of the ``_dist`` logs). Full mode only.
+    settings identified from the log, the phantom's motion replayed where the
+    log shows it). Full mode only.
     """
     if ctx.data_dir is None:
         raise StageSkipped("no real data (pass --data-dir or set VIC_DRAKE_DATA)")
@@ -50,14 +51,33 @@ def stage_compare_real(ctx: RunContext) -> dict:
     ctx.tables.append(
         ReportTable(
             "Real experiments re-run in simulation (measured map)",
-            ["log", *COMPARE_REAL_KEYS],
             [
-                [name, *(res[0].get(k) for k in COMPARE_REAL_KEYS)]
+                "log",
+                *COMPARE_REAL_KEYS,
+                "contact loss sim / real / both [s]",
+                "phantom motion max [mm]",
+            ],
+            [
+                [
+                    name,
+                    *(res[0].get(k) for k in COMPARE_REAL_KEYS),
+                    " / ".join(
+                        f"{res[0][k]:.2f}"
+                        for k in (
+                            "contact_loss_total_sim_s",
+                            "contact_loss_total_real_s",
+                            "contact_loss_overlap_s",
+                        )
+                    ),
+                    f"{res[0]['phantom_motion_max_mm']:.1f}"
+                    + ("" if res[0]["phantom_motion_replayed"] else " (not replayed)"),
+                ]
                 for name, res in out.items()
             ],
-            "vic_drake.experiments.compare_real: each real scan's target, controller settings "
-            "and (for _dist logs) estimated phantom lift, simulated and compared with the log "
-            "after time alignment. kz_corr: correlation of simulated and logged K_z.",
+            "vic_drake.experiments.compare_real: each real scan's target, the controller "
+            "and settings identified from its signals, and the phantom's motion estimated "
+            "from the log (replayed where significant), simulated and compared with the "
+            "log after time alignment. kz_corr: correlation of simulated and logged K_z.",
         )
     )
     # Function-local: matplotlib (heavy).
