@@ -17,6 +17,7 @@ import numpy as np
 import pandas as pd
 
 from vic_drake.control.params import ControllerParams
+from vic_drake.control.replay import REPLAY_COLUMNS
 from vic_drake.control.stiffness_qp.problem import make_stiffness_qp_problem
 from vic_drake.errors import VicDrakeError
 
@@ -91,12 +92,7 @@ def r_weight_per_tick(real: pd.DataFrame) -> np.ndarray:
     """
     params = logged_params(real, 1.0)
     qp, tank = params.qp, params.tank
-    cols = [
-        "t_s", "x_m", "y_m", "z_m", "x_d_m", "y_d_m", "z_d_m",
-        "vx_m_per_s", "vy_m_per_s", "vz_m_per_s", "force_ref_z_N", "force_min_z_N",
-        "tank_energy_J", "stiffness_x_N_per_m", "stiffness_y_N_per_m", "stiffness_z_N_per_m",
-    ]  # fmt: skip
-    data = real[cols].to_numpy(dtype=float)
+    data = real[list(REPLAY_COLUMNS)].to_numpy(dtype=float)
     k_lo, k_hi = qp.stiffness_min_N_per_m[2], qp.stiffness_max_N_per_m[2]
     f_hi = qp.force_max_N[2]
     q = qp.q_weight[2]

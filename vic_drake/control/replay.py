@@ -90,6 +90,14 @@ class ReplayResult:
         }
 
 
+#: The 31-column log's signals that one replayed tick reads, in order.
+REPLAY_COLUMNS = (
+    "t_s", "x_m", "y_m", "z_m", "x_d_m", "y_d_m", "z_d_m",
+    "vx_m_per_s", "vy_m_per_s", "vz_m_per_s", "force_ref_z_N", "force_min_z_N",
+    "tank_energy_J", "stiffness_x_N_per_m", "stiffness_y_N_per_m", "stiffness_z_N_per_m",
+)  # fmt: skip
+
+
 def _logged_constant(df: pd.DataFrame, column: str) -> float:
     """The value of a column the controller logged as a constant setting."""
     logged = df[column].to_numpy(dtype=float)
@@ -167,11 +175,7 @@ def replay_controller_log(
             f"the log's logged settings are not a valid controller: {exc}"
         ) from exc
 
-    cols = [
-        "t_s", "x_m", "y_m", "z_m", "x_d_m", "y_d_m", "z_d_m",
-        "vx_m_per_s", "vy_m_per_s", "vz_m_per_s", "force_ref_z_N", "force_min_z_N",
-        "tank_energy_J", "stiffness_x_N_per_m", "stiffness_y_N_per_m", "stiffness_z_N_per_m",
-    ]  # fmt: skip
+    cols = list(REPLAY_COLUMNS)
     data = df[cols].to_numpy(dtype=float)
     if not np.all(np.isfinite(data)):
         bad = [c for c in cols if not np.all(np.isfinite(df[c].to_numpy(dtype=float)))]

@@ -43,6 +43,24 @@ def test_notes_of_a_run_without_real_data(tmp_path, monkeypatch):
     assert "Control run" in text and "C2 fails" in text and "0.97" in text
 
 
+def test_notes_name_the_real_log_that_misses_c2(tmp_path, monkeypatch):
+    ctx = _ctx(tmp_path, monkeypatch, ["offline_sim", "offline_real"])
+    good = {"r2": 0.97, "spearman": -1.0, "a": 0.1, "ratio_last_first": 0.13}
+    bad = {"r2": 0.26, "spearman": -0.81, "a": 0.02, "ratio_last_first": 0.26}
+    claims = {
+        "C2": {
+            "real": {
+                "test_soft_1hz": {**good, "pass": True},
+                "test_soft_25hz": {**bad, "pass": False},
+            },
+            "pass_real": False,
+        }
+    }
+    text = " ".join(report_notes(ctx, claims))
+    assert "test_soft_25hz misses R^2 0.26 (needs >= 0.9)" in text
+    assert "test_soft_1hz misses" not in text and "Spearman" not in text
+
+
 def test_notes_with_real_logs_and_a_passing_c2(tmp_path, monkeypatch):
     ctx = _ctx(tmp_path, monkeypatch, ["offline_sim", "offline_real", "real_scans"])
     claims = {"C2": {"sim": {"ratio_last_first": 0.3}, "pass_sim": True}}
