@@ -54,7 +54,9 @@ def test_reproduce_quick_end_to_end(tmp_path):
     assert (tmp_path / "replay.html").is_file()
     logs = sorted(p.name for p in (tmp_path / "logs").iterdir())
     parquet = [n for n in logs if n.endswith(".parquet")]
-    # 7 scans, the simulated palpation (quick: one) and the map campaign.
-    assert len(parquet) == 9, parquet
+    # 7 scans, the simulated palpation (quick: one) on relaxing tissue and
+    # its plain-HC control, and the map campaign.
+    assert len(parquet) == 10, parquet
+    assert "palpation_sim_hc_2.5hz.parquet" in parquet
     for n in parquet:  # every log has its configuration beside it
         assert n.replace(".parquet", ".yaml") in logs
