@@ -16,6 +16,7 @@ from vic_drake.reproduce.report import (  # noqa: E402
     render_report,
     write_report,
 )
+from vic_drake.reproduce.stages.claims import _TABLE_KEYS
 
 
 def _content():
@@ -98,18 +99,7 @@ def test_render_without_claims():
 def _wide_content():
     """A report like a run's: the 12-column scan-metrics table, long claims."""
     content = _content()
-    keys = [
-        "force_rmse_N",
-        "force_range_N",
-        "peak_force_N",
-        "lifted_off",
-        "penetration_error_off_ribs_median_m",
-        "force_on_ribs_p99_N",
-        "n_contact_losses",
-        "fraction_at_k_min_during_loss",
-        "tank_min_J",
-        "tank_power_min_W",
-    ]
+    keys = list(_TABLE_KEYS)
     rows = [
         ["disturbance", c, *(123.456789 * (i + 1) for i in range(len(keys)))]
         for c in ("cs", "cf", "vs-cf", "vs-vf")
