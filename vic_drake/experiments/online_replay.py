@@ -157,10 +157,11 @@ def replay_online(
     trace = run_online(
         t, _delay(z, d), _delay(vz, d), force, _delay(surface, d), params
     )
-    return _score(kind, trace, kappa_ref, lam_ref, lag, params)
+    return score_online(kind, trace, kappa_ref, lam_ref, lag, params)
 
 
-def _score(kind, trace, kappa_ref, lam_ref, lag, params) -> OnlineReplay:
+def score_online(kind, trace, kappa_ref, lam_ref, lag, params) -> OnlineReplay:
+    """The replay's scores (the ``--json`` keys) of a trace against its reference."""
     contact = trace.column("in_contact") > 0.5
     if contact.sum() < 10:
         raise VicDrakeError(
@@ -188,4 +189,4 @@ def _score(kind, trace, kappa_ref, lam_ref, lag, params) -> OnlineReplay:
     return OnlineReplay(kind, trace, kappa_ref, lam_ref, lag, summary, float(final))
 
 
-__all__ = ["REPLAY_LAYOUTS", "OnlineReplay", "replay_online"]
+__all__ = ["REPLAY_LAYOUTS", "OnlineReplay", "replay_online", "score_online"]

@@ -14,8 +14,6 @@ import numpy as np
 from vic_drake.estimation.online import (
     ONLINE_METHODS,
     OnlineEstimatorParams,
-    convergence_time_s,
-    relative_errors,
     run_online,
 )
 from vic_drake.reproduce.context import RunContext, StageSkipped
@@ -50,7 +48,9 @@ def _row(name: str, method: str, summary: dict) -> list:
 def replay_simulated_scan(df, phantom, params: OnlineEstimatorParams) -> tuple:
     """(trace, kappa_true, summary) of one estimator over a simulated scan.
 
-    The estimator sees what the real one would: tip height and rate, the
+    Scored as ``vic-drake estimate-online`` scores a log
+    (:func:`~vic_drake.experiments.online_replay.score_online`). The
+    estimator sees what the real one would: tip height and rate, the
     sensor's force and the surface of the phantom at rest under the probe
     (the map, not the simulation's lifted truth); it is scored against the
     true kappa under the probe.
@@ -65,26 +65,12 @@ def replay_simulated_scan(df, phantom, params: OnlineEstimatorParams) -> tuple:
         np.asarray(tissue.surface_z_m, float),
         params,
     )
+    # Function-local: the replay module reads bags (pandas, rosbags).
+    from vic_drake.experiments.online_replay import score_online
+
     kappa = np.asarray(tissue.kappa, float)
-    contact = trace.in_contact
-    corr = float("nan")
-    if contact.sum() > 2 and np.ptp(kappa[contact]) > 0:
-        corr = float(np.corrcoef(trace.kappa[contact], kappa[contact])[0, 1])
-    summary = {
-        "kappa_rel_err_median": float(
-            np.median(relative_errors(trace.kappa, kappa, contact))
-        )
-        if contact.any()
-        else float("nan"),
-        "kappa_corr": corr,
-        "lambda_rel_err_median": float(
-            np.median(relative_errors(trace.lam, np.asarray(tissue.lam), contact))
-        )
-        if contact.any()
-        else float("nan"),
-        "convergence_s": convergence_time_s(t, trace.kappa, kappa, contact),
-        "tick_us_p99": float(np.percentile(trace.tick_s, 99) * 1e6),
-    }
+    lam = np.asarray(tissue.lam, float)
+    summary = score_online("scan", trace, kappa, lam, 0.0, params).summary
     return trace, kappa, summary
 
 
