@@ -43,8 +43,10 @@ def test_default_law_relaxes_and_hc_has_no_state():
     fresh = station.GetOutputPort("tissue.force_W").Eval(context)[2]
     assert relaxed > 0.0
     assert fresh - force == pytest.approx(relaxed, rel=1e-4)
-    _, _, _, hc_context = _press(phantom, "hc", t_s=0.01)
-    assert hc_context.num_discrete_state_groups() == 0
+    _, _, hc_tissue, hc_context = _press(phantom, "hc", t_s=0.01)
+    assert hc_tissue.get_relaxation_state_index() is None
+    # Only the stored sample and its tick.
+    assert hc_context.num_discrete_state_groups() == 2
 
 
 def test_unknown_tissue_law_is_named():

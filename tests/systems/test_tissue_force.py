@@ -6,7 +6,11 @@ from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.math import SpatialVelocity
 from pydrake.multibody.tree import BodyIndex
 
-from vic_drake.systems.tissue_force import TissueForceElement, tip_contact
+from vic_drake.systems.tissue_force import (
+    SAMPLE_FIELDS,
+    TissueForceElement,
+    tip_contact,
+)
 from vic_drake.tissue import GridPhantom, PointLookup, hunt_crossley_force
 
 
@@ -191,6 +195,7 @@ def test_ports_carry_the_station_signal_names():
         "tissue.surface_z": 1,
         "probe.position": 3,
         "probe.velocity": 3,
+        "tissue.sample": len(SAMPLE_FIELDS),
     }
     assert system.get_force_output_port().get_name() == "tissue.force_W"
     assert system.get_tip_position_output_port().get_name() == "probe.position"
@@ -223,7 +228,7 @@ def test_relaxing_element_decays_like_the_prony_series():
     assert system.get_force_output_port().Eval(context)[2] == pytest.approx(hc)
     for k in range(1, 501):
         update = system.EvalUniquePeriodicDiscreteUpdate(context)
-        context.SetDiscreteState(update.get_vector().get_value())
+        context.get_mutable_discrete_state().SetFrom(update)
         if k % 100 == 0:
             force = system.get_force_output_port().Eval(context)[2]
             expected = hc * float(relaxation.relaxation_function(k * 0.002))
@@ -237,4 +242,57 @@ def test_relaxing_element_decays_like_the_prony_series():
         phantom_body_index=BodyIndex(2),
     )
     assert plain.get_relaxation_state_index() is None
-    assert plain.CreateDefaultContext().num_discrete_state_groups() == 0
+    # Only the sample and its tick: no branch states.
+    assert plain.CreateDefaultContext().num_discrete_state_groups() == 2
+
+
+def test_the_stored_sample_is_the_contact_the_next_plant_step_uses():
+    """In a scan, the state the tick stores equals the live contact at the next step.
+
+    The element relies on the plant stepping in an unrestricted update, before
+    the discrete updates of the same tick (the plant's sampled output ports);
+    if Drake ever orders them otherwise, this fails.
+    """
+    from pydrake.systems.analysis import Simulator
+
+    from vic_drake.experiments import synthetic_scenario
+    from vic_drake.experiments.scan_diagram import (
+        MakeScanDiagram,
+        initial_joint_positions,
+        set_initial_state,
+    )
+
+    scenario = synthetic_scenario("vs-vf")
+    diagram, _ = MakeScanDiagram(scenario)
+    simulator = Simulator(diagram)
+    root = simulator.get_mutable_context()
+    set_initial_state(diagram, root, initial_joint_positions(scenario))
+    simulator.Initialize()
+    station = diagram.GetSubsystemByName("station")
+    element = station.GetSubsystemByName("tissue_force")
+    context = element.GetMyContextFromRoot(root)
+    field = {name: i for i, name in enumerate(SAMPLE_FIELDS)}
+    pressed = 0
+    for t in np.arange(2.5, 4.5, 0.1):
+        simulator.AdvanceTo(t)
+        sample = element.get_sample_output_port().Eval(context)
+        contact = element.contact(context)  # live, from the inputs and state
+        np.testing.assert_array_equal(
+            sample[[field["x_m"], field["y_m"], field["z_m"]]],
+            element.get_tip_position_output_port().Eval(context),
+        )
+        np.testing.assert_array_equal(
+            sample[[field["vx_m_per_s"], field["vy_m_per_s"], field["vz_m_per_s"]]],
+            element.get_tip_velocity_output_port().Eval(context),
+        )
+        np.testing.assert_array_equal(
+            sample[[field["force_x_N"], field["force_y_N"], field["force_z_N"]]],
+            contact.force_W,
+        )
+        assert sample[field["penetration_m"]] == contact.penetration_m
+        assert sample[field["surface_z_m"]] == contact.surface_z_m
+        # The plant's next step reads the stored sample (its tick is now).
+        forces = element.get_spatial_forces_output_port().Eval(context)
+        np.testing.assert_array_equal(forces[0].F_Bq_W.translational(), contact.force_W)
+        pressed += contact.force_N > 1.0
+    assert pressed >= 5  # the comparison covered the tip in the tissue

@@ -17,6 +17,7 @@ import pandas as pd
 from vic_drake.analysis.columns import CANONICAL_COLUMNS
 from vic_drake.errors import VicDrakeError
 from vic_drake.systems.signals import STATUS_FIELDS, TANK_FIELDS
+from vic_drake.systems.tissue_force import SAMPLE_FIELDS
 
 #: Layout of a 3-vector port in W.
 XYZ = ("x", "y", "z")
@@ -60,8 +61,21 @@ def _xyz(*columns: str) -> dict[str, str]:
 
 #: Logged signal groups of the scan diagram (see :func:`logs_to_frame`).
 LOG_GROUPS = (
+    # The tip and the tissue as the tissue element stores them after each
+    # tick: logging them costs no recomputation.
     LogGroup(
-        "probe_position", "station", "probe.position", XYZ, _xyz("x_m", "y_m", "z_m")
+        "tissue",
+        "station",
+        "tissue.sample",
+        SAMPLE_FIELDS,
+        {
+            "x_m": "x_m",
+            "y_m": "y_m",
+            "z_m": "z_m",
+            "force_z_N": "force_tissue_z_N",
+            "penetration_m": "penetration_m",
+            "surface_z_m": "surface_z_m",
+        },
     ),
     LogGroup(
         "target", "target", "target_position", XYZ, _xyz("x_d_m", "y_d_m", "z_d_m")
@@ -72,23 +86,6 @@ LOG_GROUPS = (
         "ft_sensor.force_W",
         XYZ,
         _xyz("force_sensor_x_N", "force_sensor_y_N", "force_sensor_z_N"),
-    ),
-    LogGroup(
-        "tissue_force", "station", "tissue.force_W", XYZ, {"z": "force_tissue_z_N"}
-    ),
-    LogGroup(
-        "penetration",
-        "station",
-        "tissue.penetration",
-        ("penetration",),
-        {"penetration": "penetration_m"},
-    ),
-    LogGroup(
-        "surface",
-        "station",
-        "tissue.surface_z",
-        ("surface_z",),
-        {"surface_z": "surface_z_m"},
     ),
     LogGroup(
         "phantom_lift",

@@ -76,6 +76,9 @@ def MakeStation(
         tissue.force_W (3): true Hunt-Crossley force on the tip, N (+z up).
         tissue.penetration (1): eps = surface - tip height, m.
         tissue.surface_z (1): surface height under the tip in W, m.
+        tissue.sample (17): the tip and the tissue after the last tick, as
+            stored by the tissue element (its ``SAMPLE_FIELDS``; what the
+            scan logs).
         phantom.z_offset (1): the phantom's current lift, m.
         plant.body_poses, plant.contact_results: for logging/visualization.
     """
@@ -125,6 +128,7 @@ def MakeStation(
     builder.ExportOutput(tissue.get_force_output_port(), "tissue.force_W")
     builder.ExportOutput(tissue.get_penetration_output_port(), "tissue.penetration")
     builder.ExportOutput(tissue.get_surface_z_output_port(), "tissue.surface_z")
+    builder.ExportOutput(tissue.get_sample_output_port(), "tissue.sample")
 
     # F/T sensor from the weld's reaction.
     m_ws, m_i = params.ft_wrench_mass_kg, params.indenter_mass_kg

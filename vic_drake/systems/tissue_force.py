@@ -42,6 +42,7 @@ Geometry and signs (all in the world frame W = the rig's ``base_link``):
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -58,9 +59,6 @@ from vic_drake.tissue import (
     Phantom,
     PointLookup,
     RelaxationParams,
-    hunt_crossley_force,
-    relaxation_input,
-    relaxation_step,
 )
 
 
@@ -104,15 +102,42 @@ class TipContact:
         )
 
 
-@dataclass(frozen=True)
-class _Cached:
-    """Per-step cache of the force element: the contact and where it acts."""
+def _contact_terms(
+    sample, beta, p_WT, v_WT, p_WPh, v_WPh, mu, slip, along_normal, relaxed
+) -> tuple:
+    """The :class:`TipContact` fields, in order, computed on floats.
 
-    contact: TipContact
-    p_WT: np.ndarray
-    p_WPh: np.ndarray
-    v_WT: np.ndarray
-    f_W: np.ndarray  # contact.force_W
+    ``sample`` is the map's ``(surface_z_m, dz_dx, dz_dy, kappa, lam)`` at
+    the tip, in the phantom's frame; the vectors are 3-sequences of floats;
+    ``mu``, ``slip``, ``along_normal`` and ``relaxed`` are
+    :func:`tip_contact`'s friction, normal and relaxation settings. Plain
+    Python floats: this runs every step, and numpy's per-call cost dominates
+    at this size.
+    """
+    z_s, gx, gy, kappa, lam = sample
+    surface = z_s + p_WPh[2]
+    eps = surface - p_WT[2]
+    vx, vy, vz = v_WT[0] - v_WPh[0], v_WT[1] - v_WPh[1], v_WT[2] - v_WPh[2]
+    eps_dot = gx * vx + gy * vy - vz
+    force = 0.0  # out of contact (the law's value too)
+    if eps > 0.0:
+        # hunt_crossley_force(eps, eps_dot, kappa, lam, beta), less the relaxed part.
+        force = max(eps**beta * (kappa + lam * eps_dot) - kappa * relaxed, 0.0)
+    fx = fy = tx = ty = 0.0
+    if force > 0.0:
+        if mu > 0.0:
+            scale = -mu * force / math.sqrt(vx * vx + vy * vy + slip**2)
+            fx, fy = scale * vx, scale * vy
+        if along_normal:
+            tx, ty = -gx * force, -gy * force
+    return force, eps, eps_dot, surface, kappa, lam, fx, fy, tx, ty
+
+
+_SAMPLE_FIELDS = ("surface_z_m", "dz_dx", "dz_dy", "kappa", "lam")
+
+
+def _floats3(v) -> list[float]:
+    return np.asarray(v, float).reshape(3).tolist()
 
 
 def tip_contact(
@@ -151,55 +176,42 @@ def tip_contact(
     Returns:
         The :class:`TipContact` (see the module docstring for the formulas).
     """
-    p_WT = np.asarray(p_WT, float)
-    v_WT = np.asarray(v_WT, float)
-    p_WPh = np.asarray(p_WPh, float)
-    v_WPh = np.asarray(v_WPh, float)
+    p_WT, v_WT = _floats3(p_WT), _floats3(v_WT)
+    p_WPh, v_WPh = _floats3(p_WPh), _floats3(v_WPh)
     x_map, y_map = p_WT[0] - p_WPh[0], p_WT[1] - p_WPh[1]
-    s = phantom.sample(x_map, y_map)
-    surface = float(s.surface_z_m) + p_WPh[2]
-    eps = surface - p_WT[2]
-    v_rel = v_WT - v_WPh
-    eps_dot = float(s.dz_dx) * v_rel[0] + float(s.dz_dy) * v_rel[1] - v_rel[2]
-    force = 0.0  # out of contact (the law's value too; skips its numpy cost)
-    if eps > 0.0:
-        force = float(hunt_crossley_force(eps, eps_dot, s.kappa, s.lam, phantom.beta))
-        force = max(force - float(s.kappa) * relaxed_m_beta, 0.0)
-    fx = fy = 0.0
-    if friction_coefficient > 0.0 and force > 0.0:
-        vx, vy = float(v_rel[0]), float(v_rel[1])
-        scale = (
-            -friction_coefficient
-            * force
-            / np.sqrt(vx * vx + vy * vy + slip_speed_m_per_s**2)
-        )
-        fx, fy = scale * vx, scale * vy
-    tx = ty = 0.0
-    if along_normal and force > 0.0:
-        tx, ty = -float(s.dz_dx) * force, -float(s.dz_dy) * force
+    if isinstance(phantom, PointLookup):
+        sample = phantom(x_map, y_map)
+    else:
+        s = phantom.sample(x_map, y_map)
+        sample = tuple(float(getattr(s, name)) for name in _SAMPLE_FIELDS)
     return TipContact(
-        force,
-        float(eps),
-        float(eps_dot),
-        surface,
-        float(s.kappa),
-        float(s.lam),
-        fx,
-        fy,
-        tx,
-        ty,
+        *_contact_terms(
+            sample,
+            float(phantom.beta),
+            p_WT,
+            v_WT,
+            p_WPh,
+            v_WPh,
+            float(friction_coefficient),
+            float(slip_speed_m_per_s),
+            bool(along_normal),
+            float(relaxed_m_beta),
+        )
     )
 
 
-def _cross(a, b) -> np.ndarray:
-    """a x b for 3-vectors (cheaper than np.cross at this size; this runs each step)."""
-    return np.array(
-        [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ]
-    )
+#: Elements of the element's ``tissue.sample`` output (its state after each
+#: tick): the tip's kinematics, the force on it, the contact and the map
+#: there, and the point of the reaction in the phantom body's frame.
+SAMPLE_FIELDS = (
+    "x_m", "y_m", "z_m",
+    "vx_m_per_s", "vy_m_per_s", "vz_m_per_s",
+    "force_x_N", "force_y_N", "force_z_N",
+    "penetration_m", "penetration_rate_m_per_s", "surface_z_m",
+    "kappa", "lam",
+    "reaction_x_m", "reaction_y_m", "reaction_z_m",
+)  # fmt: skip
+_SAMPLE_SIZE = len(SAMPLE_FIELDS)
 
 
 class TissueForceElement(LeafSystem):
@@ -220,11 +232,30 @@ class TissueForceElement(LeafSystem):
         probe.position: (3,) p_WT, m, and probe.velocity: (3,) v_WT, m/s
             (the probe tip's kinematics, computed here anyway; the station
             exports them under the same names).
+        tissue.sample: (17,) the same quantities (:data:`SAMPLE_FIELDS`) as
+            this element's state after its last tick, for loggers: read
+            after a tick it equals the ports above at no cost.
 
-    Discrete state (with a relaxation only): the K relaxation branch states,
-    m^beta, updated every ``update_period_s``
+    The ports above are computed from the inputs (and the relaxation state),
+    so they are right in any context. ``tissue.sample`` and, in a
+    simulation, ``spatial_forces`` come from the state that the tick's
+    update stores (see below).
+
+    Discrete state, updated every ``update_period_s``: the K relaxation
+    branch states (with a relaxation only), m^beta
     (:func:`vic_drake.tissue.relaxation_step`, exact for the penetration
-    held over the tick).
+    held over the tick); the sample; and the tick it is valid for.
+
+    Timing: the plant's discrete step is an unrestricted update, which the
+    Simulator runs before the discrete updates of the same tick; so this
+    element's update sees the plant state of the next tick, and the sample
+    it stores (with the branch states after the tick) is exactly the
+    contact the next plant step asks for. ``spatial_forces`` uses it when
+    the context's time is that tick; otherwise (a context set by hand, no
+    tick yet) it computes the contact from the inputs. An initialization
+    event stores the first sample. Set a state by hand only before
+    ``Simulator.Initialize`` (or take one step after it), as for the
+    plant's sampled output ports.
 
     Outputs depend on the plant's state and this state only (no direct
     feedthrough from the applied-force input), so the loop through the plant
@@ -260,7 +291,8 @@ class TissueForceElement(LeafSystem):
             relaxation: the tissue's stress relaxation
                 (:mod:`vic_drake.tissue.relaxation`; the phantom's kappa is
                 then the instantaneous modulus); None: plain Hunt-Crossley.
-            update_period_s: period of the relaxation state's update, s.
+            update_period_s: period of the state's update (the plant's
+                step), s.
         """
         if not (np.isfinite(update_period_s) and update_period_s > 0):
             raise VicDrakeError(f"update_period_s must be > 0, got {update_period_s!r}")
@@ -272,11 +304,15 @@ class TissueForceElement(LeafSystem):
             raise VicDrakeError(
                 f"slip_speed_m_per_s must be > 0, got {slip_speed_m_per_s!r}"
             )
-        self._mu = float(friction_coefficient)
-        self._along_normal = bool(along_normal)
-        self._slip = float(slip_speed_m_per_s)
         super().__init__()
+        self._settings = (
+            float(friction_coefficient),
+            float(slip_speed_m_per_s),
+            bool(along_normal),
+        )
         self._phantom = phantom.point_lookup(resolution_m=lookup_resolution_m)
+        self._beta = float(self._phantom.beta)
+        self._period = float(update_period_s)
         self._indenter = indenter_body_index
         self._phantom_body = phantom_body_index
         on_tip = ExternallyAppliedSpatialForce()
@@ -290,79 +326,81 @@ class TissueForceElement(LeafSystem):
             int(indenter_body_index),
             int(phantom_body_index),
         )
-        self._p_BT = np.asarray(p_BT, float).reshape(3)
+        self._p_BT = np.asarray(p_BT, float).reshape(3).tolist()
         self._poses_port = self.DeclareAbstractInputPort(
             "body_poses", AbstractValue.Make([RigidTransform()])
         )
         self._velocities_port = self.DeclareAbstractInputPort(
             "body_spatial_velocities", AbstractValue.Make([SpatialVelocity()])
         )
-        # Relaxation: one discrete state vector (the branch states, m^beta),
-        # updated exactly for the penetration held over each tick.
+        # Relaxation: the branch states (m^beta), updated exactly for the
+        # penetration held over each tick.
         self._branches = None
+        self._g = self._decay = ()
         prerequisites = {self.all_input_ports_ticket()}
         if relaxation is not None and relaxation.n_branches:
-            self._g = np.asarray(relaxation.fractions)
-            self._taus = np.asarray(relaxation.time_constants_s)
-            self._period = float(update_period_s)
+            self._g = tuple(float(g) for g in relaxation.fractions)
+            # exp(-dt / tau_i), as relaxation_step computes it.
+            self._decay = tuple(
+                np.exp(-self._period / np.asarray(relaxation.time_constants_s, float))
+                .astype(float)
+                .tolist()
+            )
             self._branches = self.DeclareDiscreteState(relaxation.n_branches)
-            self.DeclarePeriodicDiscreteUpdateEvent(
-                float(update_period_s), 0.0, self._update_relaxation
-            )
             prerequisites.add(self.discrete_state_ticket(self._branches))
-        model_value = AbstractValue.Make(
-            _Cached(
-                TipContact(0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
-                np.zeros(3),
-                np.zeros(3),
-                np.zeros(3),
-                np.zeros(3),
-            )
-        )
+        self._sample = self.DeclareDiscreteState(_SAMPLE_SIZE)
+        self._sample_tick = self.DeclareDiscreteState([-1.0])  # none yet
+        self.DeclarePeriodicDiscreteUpdateEvent(self._period, 0.0, self._update)
+        self.DeclareInitializationDiscreteUpdateEvent(self._initialize)
         self._contact_cache = self.DeclareCacheEntry(
             description="tip_contact",
             value_producer=ValueProducer(
-                allocate=model_value.Clone, calc=self._calc_contact
+                allocate=AbstractValue.Make(None).Clone, calc=self._calc_contact
             ),
             prerequisites_of_calc=prerequisites,
         )
+        live = {self._contact_cache.ticket()}
         self._forces_port = self.DeclareAbstractOutputPort(
             "spatial_forces",
             lambda: AbstractValue.Make([ExternallyAppliedSpatialForce()]),
             self._calc_spatial_forces,
-            prerequisites_of_calc={self._contact_cache.ticket()},
+            prerequisites_of_calc={
+                self.all_input_ports_ticket(),
+                self.all_state_ticket(),
+                self.time_ticket(),
+            },
         )
         self._force_port = self.DeclareVectorOutputPort(
             "tissue.force_W",
             3,
-            self._calc_force,
-            prerequisites_of_calc={self._contact_cache.ticket()},
+            lambda c, out: out.SetFromVector(np.array(self._contact_cache.Eval(c)[2])),
+            prerequisites_of_calc=live,
         )
         self._penetration_port = self.DeclareVectorOutputPort(
             "tissue.penetration",
             1,
-            lambda c, out: out.SetAtIndex(0, self._contact(c).penetration_m),
-            prerequisites_of_calc={self._contact_cache.ticket()},
+            lambda c, out: out.SetAtIndex(0, self._contact_cache.Eval(c)[3][1]),
+            prerequisites_of_calc=live,
         )
         self._surface_port = self.DeclareVectorOutputPort(
             "tissue.surface_z",
             1,
-            lambda c, out: out.SetAtIndex(0, self._contact(c).surface_z_m),
-            prerequisites_of_calc={self._contact_cache.ticket()},
+            lambda c, out: out.SetAtIndex(0, self._contact_cache.Eval(c)[3][3]),
+            prerequisites_of_calc=live,
         )
-
         self._tip_position_port = self.DeclareVectorOutputPort(
             "probe.position",
             3,
-            lambda c, out: out.SetFromVector(self._contact_cache.Eval(c).p_WT),
-            prerequisites_of_calc={self._contact_cache.ticket()},
+            lambda c, out: out.SetFromVector(self._contact_cache.Eval(c)[0]),
+            prerequisites_of_calc=live,
         )
         self._tip_velocity_port = self.DeclareVectorOutputPort(
             "probe.velocity",
             3,
-            lambda c, out: out.SetFromVector(self._contact_cache.Eval(c).v_WT),
-            prerequisites_of_calc={self._contact_cache.ticket()},
+            lambda c, out: out.SetFromVector(self._contact_cache.Eval(c)[1]),
+            prerequisites_of_calc=live,
         )
+        self._sample_port = self.DeclareStateOutputPort("tissue.sample", self._sample)
 
     def get_body_poses_input_port(self):
         return self._poses_port
@@ -388,64 +426,116 @@ class TissueForceElement(LeafSystem):
     def get_tip_velocity_output_port(self):
         return self._tip_velocity_port
 
+    def get_sample_output_port(self):
+        return self._sample_port
+
     def tip_position(self, context) -> np.ndarray:
         """p_WT, m, from the body poses input."""
-        return self._contact_cache.Eval(context).p_WT.copy()
+        return self._contact_cache.Eval(context)[0].copy()
 
-    def _contact(self, context) -> TipContact:
-        return self._contact_cache.Eval(context).contact
+    def contact(self, context) -> TipContact:
+        """The tissue at the tip in this context (from the inputs and state)."""
+        return TipContact(*self._contact_cache.Eval(context)[3])
 
     def get_relaxation_state_index(self):
         """Index of the relaxation branch states (None without relaxation)."""
         return self._branches
 
-    def _update_relaxation(self, context, discrete_state):
-        u = relaxation_input(self._contact(context).penetration_m, self._phantom.beta)
-        s = context.get_discrete_state(self._branches).get_value()
-        discrete_state.get_mutable_vector(self._branches).SetFromVector(
-            relaxation_step(s, u, self._period, self._taus)
-        )
+    def _relaxed(self, context) -> float:
+        """sum_i g_i s_i of the branch states in ``context``, m^beta."""
+        if self._branches is None:
+            return 0.0
+        s = context.get_discrete_state(self._branches).value().tolist()
+        return sum(g * s_i for g, s_i in zip(self._g, s, strict=True))
 
     def _calc_contact(self, context, value):
+        # Cached: p_WT, v_WT (arrays), f_W, the contact terms, the map sample,
+        # then p_WT, v_WT, p_WPh, v_WPh as lists of floats.
         poses = self._poses_port.Eval(context)
         velocities = self._velocities_port.Eval(context)
-        X_WB = poses[self._i_indenter]
-        V_WB = velocities[self._i_indenter]
-        p_BT_W = X_WB.rotation() @ self._p_BT
-        p_WT = X_WB.translation() + p_BT_W
-        v_WT = V_WB.translational() + _cross(V_WB.rotational(), p_BT_W)
-        p_WPh = poses[self._i_phantom].translation()
-        V_WPh = velocities[self._i_phantom]
+        X = poses[self._i_indenter].GetAsMatrix34().tolist()
+        V = velocities[self._i_indenter].get_coeffs().tolist()  # [w; v]
+        bx, by, bz = self._p_BT
+        # p_BT expressed in W (R p_BT), in Eigen's order of the product.
+        r = [row[0] * bx + row[1] * by + row[2] * bz for row in X]
+        p_WT = [X[0][3] + r[0], X[1][3] + r[1], X[2][3] + r[2]]
+        w = V[:3]
+        v_WT = [
+            V[3] + (w[1] * r[2] - w[2] * r[1]),
+            V[4] + (w[2] * r[0] - w[0] * r[2]),
+            V[5] + (w[0] * r[1] - w[1] * r[0]),
+        ]
+        p_WPh = poses[self._i_phantom].translation().tolist()
+        v_WPh = velocities[self._i_phantom].get_coeffs()[3:].tolist()
+        sample = self._phantom(p_WT[0] - p_WPh[0], p_WT[1] - p_WPh[1])
+        terms = _contact_terms(
+            sample, self._beta, p_WT, v_WT, p_WPh, v_WPh, *self._settings,
+            self._relaxed(context),
+        )  # fmt: skip
+        # Vectors for the output ports as arrays: pybind copies an array into
+        # a port several times faster than a list.
+        value.set_value(
+            (np.array(p_WT), np.array(v_WT), _force_W(terms), terms, sample,
+             p_WT, v_WT, p_WPh, v_WPh)
+        )  # fmt: skip
+
+    def _store(self, context, discrete_state, relaxed: float, tick: float) -> None:
+        """Stores the sample of the cached kinematics at ``relaxed``, for ``tick``."""
+        _, _, _, _, sample, p_WT, v_WT, p_WPh, v_WPh = self._contact_cache.Eval(context)
+        terms = _contact_terms(
+            sample, self._beta, p_WT, v_WT, p_WPh, v_WPh, *self._settings, relaxed
+        )
+        force, eps, eps_dot, surface, kappa, lam = terms[:6]
+        discrete_state.set_value(
+            self._sample,
+            np.array([
+                *p_WT, *v_WT, *_force_W(terms), eps, eps_dot, surface, kappa, lam,
+                p_WT[0] - p_WPh[0], p_WT[1] - p_WPh[1], p_WT[2] - p_WPh[2],
+            ]),
+        )  # fmt: skip
+        discrete_state.set_value(self._sample_tick, np.array([tick]))
+
+    def _tick(self, context) -> float:
+        return float(round(context.get_time() / self._period))
+
+    def _initialize(self, context, discrete_state):
+        self._store(
+            context, discrete_state, self._relaxed(context), self._tick(context)
+        )
+
+    def _update(self, context, discrete_state):
         relaxed = 0.0
         if self._branches is not None:
-            relaxed = float(
-                self._g @ context.get_discrete_state(self._branches).get_value()
-            )
-        contact = tip_contact(
-            self._phantom,
-            p_WT,
-            v_WT,
-            p_WPh,
-            V_WPh.translational(),
-            friction_coefficient=self._mu,
-            slip_speed_m_per_s=self._slip,
-            along_normal=self._along_normal,
-            relaxed_m_beta=relaxed,
-        )
-        value.set_value(_Cached(contact, p_WT, p_WPh, v_WT, contact.force_W))
-
-    def _calc_force(self, context, output):
-        output.SetFromVector(self._contact_cache.Eval(context).f_W)
+            eps = self._contact_cache.Eval(context)[3][1]
+            u = (eps if eps > 0.0 else 0.0) ** self._beta  # relaxation_input
+            s = context.get_discrete_state(self._branches).value().tolist()
+            # relaxation_step: u + (s - u) exp(-dt / tau), per branch.
+            s = [u + (s_i - u) * d for s_i, d in zip(s, self._decay, strict=True)]
+            discrete_state.set_value(self._branches, np.array(s))
+            relaxed = sum(g * s_i for g, s_i in zip(self._g, s, strict=True))
+        self._store(context, discrete_state, relaxed, self._tick(context) + 1.0)
 
     def _calc_spatial_forces(self, context, output):
-        cached = self._contact_cache.Eval(context)
-        f_W = cached.f_W
+        tick = context.get_discrete_state(self._sample_tick).value()[0]
+        if tick == self._tick(context):
+            sample = context.get_discrete_state(self._sample).value()
+            f_W, p_PhT = sample[6:9], sample[14:17]
+        else:  # No tick stored for this time: from the inputs.
+            _, _, f_W, _, _, p_WT, _, p_WPh, _ = self._contact_cache.Eval(context)
+            f_W = np.array(f_W)
+            p_PhT = np.array([p_WT[i] - p_WPh[i] for i in range(3)])
         # set_value copies the list into the port's value, so the two force
         # records are kept and refilled (this runs every plant step).
         on_tip, on_phantom = self._applied
         on_tip.F_Bq_W = SpatialForce(self._zero_torque, f_W)
         # The reaction acts on the phantom (which only translates) at the
         # same world point.
-        on_phantom.p_BoBq_B = cached.p_WT - cached.p_WPh
+        on_phantom.p_BoBq_B = p_PhT
         on_phantom.F_Bq_W = SpatialForce(self._zero_torque, -f_W)
         output.set_value(self._applied)
+
+
+def _force_W(terms) -> list[float]:
+    """The whole force on the tip in W (:attr:`TipContact.force_W`) from the terms."""
+    force, _, _, _, _, _, fx, fy, tx, ty = terms
+    return [tx + fx, ty + fy, force]

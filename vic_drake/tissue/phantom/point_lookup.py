@@ -47,20 +47,25 @@ class PointLookup:
         self._xs = [float(v) for v in xs]
         self._ys = [float(v) for v in ys]
         self._grids = [np.asarray(g, float).tolist() for g in grids]
+        # Rows i and i + 1 of every grid, by i: the bilinear lookup's cells.
+        self._row_pairs = [
+            [(g[i], g[i + 1]) for g in self._grids] for i in range(len(self._xs) - 1)
+        ]
         self.bounds = (self._xs[0], self._xs[-1], self._ys[0], self._ys[-1])
 
-    @staticmethod
-    def _axis(axis, q):
-        """(i0, w1, inside) of q on an increasing axis, clamped."""
-        inside = axis[0] <= q <= axis[-1]
-        qc = min(max(q, axis[0]), axis[-1])
-        i1 = min(max(bisect.bisect_right(axis, qc), 1), len(axis) - 1)
-        i0 = i1 - 1
-        return i0, (qc - axis[i0]) / (axis[i1] - axis[i0]), inside
-
     def __call__(self, x, y) -> tuple[float, float, float, float, float]:
-        i, wx, in_x = self._axis(self._xs, float(x))
-        j, wy, in_y = self._axis(self._ys, float(y))
+        # The cell and weights on each axis, clamped (this runs several times
+        # a tick: inlined).
+        xs, ys = self._xs, self._ys
+        x, y = float(x), float(y)
+        in_x = xs[0] <= x <= xs[-1]
+        xc = min(max(x, xs[0]), xs[-1])
+        i = min(max(bisect.bisect_right(xs, xc), 1), len(xs) - 1) - 1
+        wx = (xc - xs[i]) / (xs[i + 1] - xs[i])
+        in_y = ys[0] <= y <= ys[-1]
+        yc = min(max(y, ys[0]), ys[-1])
+        j = min(max(bisect.bisect_right(ys, yc), 1), len(ys) - 1) - 1
+        wy = (yc - ys[j]) / (ys[j + 1] - ys[j])
         if self.nearest:
             # Half to even, as np.rint in GridPhantom.sample.
             i, j = round(i + wx), round(j + wy)
@@ -68,11 +73,11 @@ class PointLookup:
         else:
             w00, w10 = (1 - wx) * (1 - wy), wx * (1 - wy)
             w01, w11 = (1 - wx) * wy, wx * wy
-            z, gx, gy, kappa, lam = (
-                w00 * g[i][j] + w10 * g[i + 1][j] + w01 * g[i][j + 1]
-                + w11 * g[i + 1][j + 1]
-                for g in self._grids
-            )  # fmt: skip
+            j1 = j + 1
+            z, gx, gy, kappa, lam = [
+                w00 * g0[j] + w10 * g1[j] + w01 * g0[j1] + w11 * g1[j1]
+                for g0, g1 in self._row_pairs[i]
+            ]
         return z, (gx if in_x else 0.0), (gy if in_y else 0.0), kappa, lam
 
     def sample(self, x, y) -> TissueSample:
