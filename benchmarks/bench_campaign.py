@@ -23,6 +23,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from common import versions
 from pydrake.common.yaml import yaml_dump_typed
 
 from vic_drake.experiments.campaign import load_campaign_spec, read_rows, run_campaign
@@ -50,6 +51,7 @@ def main() -> int:
     p.add_argument("--workers", default="1,2")
     p.add_argument("--keep", default=None, help="keep the campaign folders here")
     args = p.parse_args()
+    print(versions())
     root = Path(args.keep or tempfile.mkdtemp(prefix="bench_campaign_"))
     root.mkdir(parents=True, exist_ok=True)
     spec = _spec_with_runs(Path(args.spec), args.runs, root)

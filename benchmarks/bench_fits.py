@@ -14,6 +14,7 @@ import argparse
 import time
 
 import numpy as np
+from common import versions
 
 from vic_drake.estimation import (
     PalpationData,
@@ -49,6 +50,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--data-dir", default=None)
     args = parser.parse_args()
+    print(versions())
 
     data = synthetic()
     print(

@@ -24,6 +24,7 @@ import sys
 import time
 
 import numpy as np
+from common import versions
 
 
 def peak_rss_mb() -> float:
@@ -97,6 +98,7 @@ def main(argv=None) -> int:
     parser.add_argument("--designs", action="store_true")
     parser.add_argument("--no-figures", action="store_true")
     args = parser.parse_args(argv)
+    print(versions())
 
     os.environ.setdefault("MPLBACKEND", "Agg")
     from vic_drake.analysis.map_compare import compare_with_phantom

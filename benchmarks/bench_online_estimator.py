@@ -7,6 +7,7 @@ shared palpation log if the data folder is present. The issue's budget is
 """
 
 import numpy as np
+from common import versions
 
 from vic_drake.estimation.online import OnlineEstimatorParams, run_online
 from vic_drake.paths import has_data, resolve_data_dir
@@ -33,6 +34,7 @@ def simulated(duration_s=20.0):
 
 
 def main():
+    print(versions())
     logs = {"simulated 1.5 Hz": simulated()}
     if has_data():
         from vic_drake.estimation.palpation import PalpationData

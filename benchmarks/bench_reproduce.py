@@ -14,6 +14,8 @@ import os
 import tempfile
 import time
 
+from common import versions
+
 from vic_drake.analysis.claims import claim_status
 from vic_drake.reproduce import ReproduceOptions, reproduce
 
@@ -25,6 +27,7 @@ def main() -> None:
         "--out", default=None, help="output folder (default: a temp dir)"
     )
     args = parser.parse_args()
+    print(versions())
     out = args.out or tempfile.mkdtemp(prefix="vic_drake_bench_")
     t0 = time.perf_counter()
     result = reproduce(ReproduceOptions(out_dir=out, quick=not args.full))

@@ -3,8 +3,7 @@
 Simulates the VS-VF nominal scan on the synthetic phantom (station with the
 UR3e and the Hunt-Crossley tissue force, F/T sensor, FDCC, stiffness QP,
 energy tank, logging at 500 Hz) and prints the real-time factor (simulated
-seconds per wall-clock second; the goal is >= 2, i.e. twice faster than real
-time), beside the ceiling: the same rig (UR3e, tool, lifted phantom, joint
+seconds per wall-clock second; the goal is >= 4), beside the ceiling: the same rig (UR3e, tool, lifted phantom, joint
 and lift servos, gravity feed-forward: every C++ system of the station, no
 Python system) holding its start pose, stepped at the same plant step. Every
 figure is printed with its Drake and Python versions and as a fraction of
@@ -13,6 +12,12 @@ and the share of the time spent in each vic_drake system.
 
     python benchmarks/bench_scan.py [--duration 5] [--scenario diagrams/X.yaml] [--top 25]
         [--qp-solver exact|osqp|clarabel] [--time-step-ms 2] [--repeat 3] [--no-profile]
+        [--baseline DIR]
+
+With ``--baseline DIR`` (another checkout, e.g. ``git worktree add DIR
+<commit>``), the scan of that code and of this checkout alternate, each in a
+fresh process, ``--repeat`` times, and the medians are printed side by side:
+the before/after figure of a change on a shared, noisy host.
 
 Figures measured with it, and the changes they led to: docs/decisions.md,
 "Scan speed".
@@ -23,24 +28,18 @@ from __future__ import annotations
 import argparse
 import copy
 import cProfile
-import importlib.metadata
 import io
-import platform
+import json
+import os
 import pstats
 import statistics
+import subprocess
+import sys
 import time
 from collections import defaultdict
 from dataclasses import replace
 
-import numpy as np
-
-
-def versions() -> str:
-    """Drake and Python versions, printed with every figure."""
-    return (
-        f"drake {importlib.metadata.version('drake')}, "
-        f"python {platform.python_version()}, numpy {np.__version__}"
-    )
+from common import versions
 
 
 def plant_ceiling_rtf(scenario, duration_s: float) -> tuple[float, float]:
@@ -75,6 +74,83 @@ def plant_ceiling_rtf(scenario, duration_s: float) -> tuple[float, float]:
     return duration_s / wall, duration_s / cpu
 
 
+def _scenario(args):
+    """The benchmarked scenario, with the command line's overrides."""
+    from vic_drake.experiments import synthetic_scenario
+    from vic_drake.scenario import load_scenario
+
+    scenario = (
+        load_scenario(args.scenario) if args.scenario else synthetic_scenario("vs-vf")
+    )
+    if args.qp_solver is not None:
+        c = scenario.controller
+        qp = replace(c.qp, solver=args.qp_solver)
+        scenario = replace(scenario, controller=replace(c, qp=qp))
+    if args.time_step_ms is not None:
+        station = copy.deepcopy(scenario.station)
+        station.plant.time_step = 1e-3 * args.time_step_ms
+        scenario = replace(scenario, station=station.validate())
+    return scenario
+
+
+def _worker(args) -> None:
+    """One scan in this process; prints its figures as one JSON line."""
+    from vic_drake.experiments import run_scan
+
+    scenario = _scenario(args)
+    result = run_scan(scenario, duration_s=args.duration)
+    ticks = result.sim_s / scenario.station.plant.time_step
+    print(
+        json.dumps(
+            {
+                "rtf": result.rtf,
+                "cpu_rtf": result.sim_s / result.cpu_s,
+                "ms_per_tick": 1e3 * result.wall_s / ticks,
+                "versions": versions(),
+            }
+        )
+    )
+
+
+def _run_tree(tree: str, args) -> dict:
+    """One scan of the code in ``tree`` (a checkout), in a fresh process."""
+    command = [sys.executable, os.path.abspath(__file__), "--worker"]
+    command += ["--duration", str(args.duration)]
+    for option in ("scenario", "qp_solver", "time_step_ms"):
+        value = getattr(args, option)
+        if value is not None:
+            command += [f"--{option.replace('_', '-')}", str(value)]
+    env = dict(os.environ, PYTHONPATH=os.path.abspath(tree))
+    done = subprocess.run(command, env=env, capture_output=True, text=True)
+    if done.returncode != 0:
+        sys.exit(f"bench_scan: the run of {tree} failed:\n{done.stderr[-2000:]}")
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def _compare(args) -> None:
+    """The scan of this checkout and of ``--baseline``, alternated, in fresh processes."""
+    here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    trees = {"baseline": args.baseline, "current": here}
+    runs = {name: [] for name in trees}
+    for _ in range(args.repeat):  # Alternated: the host is shared and noisy.
+        for name, tree in trees.items():
+            runs[name].append(_run_tree(tree, args))
+    print(f"{args.repeat} run(s) of each, alternated; medians:")
+    for name, tree in trees.items():
+        rtf = statistics.median(r["rtf"] for r in runs[name])
+        cpu = statistics.median(r["cpu_rtf"] for r in runs[name])
+        tick = statistics.median(r["ms_per_tick"] for r in runs[name])
+        print(
+            f"  {name:<9} RTF {rtf:6.3f} wall, {cpu:6.3f} CPU, {tick:6.3f} ms per tick"
+            f"  ({runs[name][0]['versions']}; {tree})"
+        )
+    ratio = statistics.median(
+        c["rtf"] / b["rtf"]
+        for c, b in zip(runs["current"], runs["baseline"], strict=True)
+    )
+    print(f"  current / baseline RTF, median of the pairs: {ratio:.2f}x")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--duration", type=float, default=5.0, help="simulated time, s")
@@ -101,25 +177,34 @@ def main() -> None:
         default=1,
         help="runs of the scan and of the ceiling, alternated; medians are printed",
     )
+    parser.add_argument(
+        "--baseline",
+        metavar="DIR",
+        default=None,
+        help="another checkout of vic_drake (e.g. a git worktree of an older "
+        "commit): its scan and this one's alternate, each in a fresh process",
+    )
+    parser.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.repeat < 1:
         parser.error(f"--repeat must be >= 1; got {args.repeat}")
-
-    from vic_drake.experiments import run_scan, synthetic_scenario
-    from vic_drake.scenario import load_scenario
-
-    scenario = (
-        load_scenario(args.scenario) if args.scenario else synthetic_scenario("vs-vf")
-    )
-    if args.qp_solver is not None:
-        c = scenario.controller
-        qp = replace(c.qp, solver=args.qp_solver)
-        scenario = replace(scenario, controller=replace(c, qp=qp))
-    if args.time_step_ms is not None:
-        station = copy.deepcopy(scenario.station)
-        station.plant.time_step = 1e-3 * args.time_step_ms
-        scenario = replace(scenario, station=station.validate())
+    if not args.duration > 0:
+        parser.error(f"--duration must be > 0; got {args.duration}")
+    if args.baseline is not None and not os.path.isdir(
+        os.path.join(args.baseline, "vic_drake")
+    ):
+        parser.error(f"--baseline must be a checkout of vic_drake; got {args.baseline}")
+    if args.worker:
+        _worker(args)
+        return
     print(versions())
+    if args.baseline is not None:
+        _compare(args)
+        return
+
+    from vic_drake.experiments import run_scan
+
+    scenario = _scenario(args)
     scans, ceilings = [], []
     for _ in range(args.repeat):  # Alternated: the host is shared and noisy.
         t0 = time.perf_counter()
@@ -143,7 +228,8 @@ def main() -> None:
     print(
         f"RTF on CPU time     {result.sim_s / result.cpu_s:.3f}  (with a core to itself)"
     )
-    print(f"per 2 ms tick       {1e3 * result.wall_s / (result.sim_s / 0.002):.3f} ms")
+    ticks = result.sim_s / scenario.station.plant.time_step
+    print(f"per tick            {1e3 * result.wall_s / ticks:.3f} ms")
     print(
         f"plant-only ceiling  RTF {ceiling:.3f} wall, {ceiling_cpu:.3f} CPU (the rig "
         "without Python systems)"

@@ -27,6 +27,7 @@ import pstats
 import time
 
 import numpy as np
+from common import versions
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource, Demultiplexer
@@ -126,6 +127,7 @@ def main(argv=None):
         help="cProfile entries to print for the fdcc_cf case (0: none)",
     )
     args = parser.parse_args(argv)
+    print(versions())
     phantom = load_phantom(args.phantom)
     params = StationParams(robot_contact=not args.no_robot_contact)
     print(
