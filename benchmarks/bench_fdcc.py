@@ -30,8 +30,9 @@ import statistics
 import time
 
 import numpy as np
+from pydrake.multibody.tree import JacobianWrtVariable
 
-from vic_drake.control.fdcc import FdccParams, fdcc_step, fdcc_tick
+from vic_drake.control.fdcc import FdccConstants, FdccParams, fdcc_step, fdcc_tick
 from vic_drake.station import StationParams, initial_q_for_tip
 from vic_drake.systems.fdcc import FdccController
 
@@ -66,7 +67,7 @@ def main(argv=None):
     model, params = system.model, system.params
     discrete_state = system.AllocateDiscreteVariables()
     discrete_state.SetFrom(context.get_discrete_state())
-    constants = system._constants
+    constants = FdccConstants.from_params(params)
     zeros = np.zeros(6)
     step_kw = dict(
         q_measured=q_m,
@@ -77,10 +78,10 @@ def main(argv=None):
         stiffness=K,
         measured_force=f_m,
         target_force=f_t,
-        R_WP_target=system._R_WP_target,
+        R_WP_target=constants.R_WP_target,
     )
     plant, scratch = model.plant, model._context
-    world = plant.world_frame()
+    world, origin = plant.world_frame(), np.zeros(3)
     q_alt = (q_m, q_m + 1e-6)
     state = {"k": 0}
 
@@ -103,8 +104,8 @@ def main(argv=None):
         "  + CalcMassMatrix": lambda: (set_positions(), plant.CalcMassMatrix(scratch)),
         "  + CalcJacobianSpatialVelocity": lambda: (
             set_positions(),
-            model._calc_jacobian(
-                scratch, model._kV, model.frame, model._p_origin, world, world
+            plant.CalcJacobianSpatialVelocity(
+                scratch, JacobianWrtVariable.kV, model.frame, origin, world, world
             ),
         ),
         "  + CalcPoseInWorld": lambda: (
