@@ -3,8 +3,15 @@
 import numpy as np
 import pytest
 from pydrake.math import RotationMatrix
+from scipy.linalg.lapack import dgesv
 
-from vic_drake.control.fdcc import FdccParams, fdcc_step, net_cartesian_error
+from vic_drake.control.fdcc import (
+    FdccConstants,
+    FdccParams,
+    fdcc_step,
+    fdcc_tick,
+    net_cartesian_error,
+)
 from vic_drake.errors import VicDrakeError
 from vic_drake.models.ur3e import MakeFdccModel, probe_down_rotation
 from vic_drake.station import StationParams, initial_q_for_tip, joint_filter_step
@@ -226,3 +233,128 @@ def test_compliance_equilibrium_against_a_spring(model, q_start):
     # Closed form: k_s (s - z) = K (z - z_d).
     z_eq = (k_spring * surface + K * target[2]) / (k_spring + K)
     assert z == pytest.approx(z_eq, abs=5e-5)
+
+
+def _numpy_oracle(model, params, q, q_prev, qd, err_prev, x_d, K, f_m, f_t):
+    """The FDCC tick written with numpy arrays, as the module docstring states it."""
+    R_d = params.R_WP_target
+    dt = params.internal_period_s
+    p, d = np.asarray(params.p_gains), np.asarray(params.d_gains)
+    K_rot = np.asarray(params.rotational_stiffness_Nm_per_rad)
+    for i in range(params.iterations):
+        X, H, J = model.dynamics(q)
+        if i == 0 and params.pose_feedback == "command":
+            X = model.pose(q_prev)
+        aa = (R_d @ X.rotation().inverse()).ToAngleAxis()
+        err = np.concatenate(
+            [
+                K * (x_d - X.translation()) + (f_t - f_m),
+                K_rot * (aa.axis() * aa.angle()),
+            ]
+        )
+        u = params.error_scale * (p * err + d * (err - err_prev) / dt)
+        err_prev = err
+        _, _, qdd, info = dgesv(H, J.T @ np.concatenate([u[3:], u[:3]]))
+        assert info == 0
+        q_next = q + qd * dt
+        qd = params.velocity_decay * (qd + qdd * dt)
+        below, above = q_next < model.q_lower, q_next > model.q_upper
+        q = np.minimum(np.maximum(q_next, model.q_lower), model.q_upper)
+        qd[(below & (qd < 0)) | (above & (qd > 0))] = 0.0
+    return q, qd, err_prev
+
+
+@pytest.mark.parametrize(
+    "kw",
+    [
+        {},
+        {"iterations": 3, "pose_feedback": "command"},
+        {
+            "iterations": 2,
+            "p_gains": [0.1, 0.2, 0.3, 0.4, 0.5, 0.6],
+            "d_gains": [0.01, 0.0, 0.02, 0.003, 0.0, 0.001],
+            "error_scale": 0.7,
+            "velocity_decay": 0.8,
+            "internal_period_s": 0.013,
+            "target_orientation_wxyz": [0.1, 0.9, -0.2, 0.05],
+        },
+    ],
+)
+def test_tick_equals_the_numpy_formulation_exactly(kw, q_start):
+    """fdcc_step / fdcc_tick (plain floats) give the numpy formulation's bits,
+    also where a joint is clamped at its limit."""
+    params = FdccParams(**kw)
+    model = MakeFdccModel(params, StationParams())
+    constants = FdccConstants.from_params(params)
+    rng = np.random.default_rng(3)
+    for k in range(40):
+        q = q_start + rng.normal(0, 0.3, 6)
+        qd = rng.normal(0, 2.0, 6)
+        if k % 4 == 0:  # at the elbow's upper limit, moving into it
+            q[2], qd[2] = model.q_upper[2] - 1e-5, 5.0
+        args = (
+            q,
+            q + rng.normal(0, 0.01, 6),
+            qd,
+            rng.normal(0, 5, 6),
+            START + rng.normal(0, 0.02, 3),
+            rng.uniform(0, 2000, 3),
+            rng.normal(0, 10, 3),
+            rng.normal(0, 10, 3),
+        )
+        want = _numpy_oracle(model, params, *args)
+        step = fdcc_step(
+            model,
+            params,
+            **dict(
+                zip(
+                    (
+                        "q_measured",
+                        "q_command_prev",
+                        "qdot",
+                        "last_error",
+                        "p_WP_target",
+                        "stiffness",
+                        "measured_force",
+                        "target_force",
+                    ),
+                    args,
+                )
+            ),
+        )
+        assert step.ok
+        for got, expected in zip((step.q_command, step.qdot, step.last_error), want):
+            np.testing.assert_array_equal(got, expected)
+        tick = fdcc_tick(model, constants, *args)
+        for got, expected in zip(tick, want):
+            np.testing.assert_array_equal(got, expected)
+
+
+def test_tick_faults(model, q_start):
+    constants = FdccConstants.from_params(FdccParams())
+    z3, z6 = np.zeros(3), np.zeros(6)
+    args = [q_start, q_start, z6, z6, START, np.full(3, 300.0), z3, z3]
+    assert fdcc_tick(model, constants, *args) is not None
+    for index, bad in [
+        (5, np.array([300.0, -1.0, 300.0])),
+        (6, np.array([0, np.inf, 0])),
+    ]:
+        faulty = list(args)
+        faulty[index] = bad
+        assert fdcc_tick(model, constants, *faulty) is None
+
+
+def test_wrong_length_argument_is_named(model, q_start):
+    with pytest.raises(VicDrakeError, match="stiffness"):
+        fdcc_step(
+            model,
+            FdccParams(),
+            q_measured=q_start,
+            q_command_prev=q_start,
+            qdot=np.zeros(6),
+            last_error=np.zeros(6),
+            p_WP_target=START,
+            stiffness=300.0,
+            measured_force=np.zeros(3),
+            target_force=np.zeros(3),
+        )

@@ -34,9 +34,12 @@ tick (500 Hz):
 
 3. the resulting q is the joint position command.
 
-Everything here is plain numpy on a MultibodyPlant context that the caller
-builds (:func:`vic_drake.models.ur3e.MakeFdccModel`); the LeafSystem
+Everything here is plain Python arithmetic (numpy and LAPACK for the 6x6
+products and solve) on a MultibodyPlant context that the caller builds
+(:func:`vic_drake.models.ur3e.MakeFdccModel`); the LeafSystem
 (:class:`vic_drake.systems.fdcc.FdccController`) holds the state.
+:func:`fdcc_step` is the checked entry point; :func:`fdcc_tick` is the same
+tick on float64 arrays with the settings already in :class:`FdccConstants`.
 
 :class:`FdccParams` is a mutable dataclass loadable by Drake's
 ``yaml_load_typed`` (which fills a default instance field by field), so it
@@ -46,6 +49,8 @@ types at run time.)
 """
 
 from dataclasses import dataclass, field
+from math import isfinite
+from typing import NamedTuple
 
 import numpy as np
 from pydrake.common.eigen_geometry import Quaternion
@@ -207,29 +212,63 @@ class FdccModel:
         self._p_origin = np.zeros(3)
         self.q_lower = plant.GetPositionLowerLimits()
         self.q_upper = plant.GetPositionUpperLimits()
+        # The per-tick calls, bound once.
+        self._set_positions = plant.SetPositions
+        self._calc_mass_matrix = plant.CalcMassMatrix
+        self._calc_jacobian = plant.CalcJacobianSpatialVelocity
+        self._calc_pose = frame.CalcPoseInWorld
+        self._kV = JacobianWrtVariable.kV
+        self._limits = tuple(zip(self.q_lower.tolist(), self.q_upper.tolist()))
 
     def set_positions(self, q) -> None:
-        self.plant.SetPositions(self._context, np.asarray(q, float))
+        self._set_positions(self._context, np.asarray(q, float))
 
     def pose(self, q=None):
         """X_WP of the probe (for q if given, else the last set positions)."""
         if q is not None:
-            self.set_positions(q)
-        return self.frame.CalcPoseInWorld(self._context)
+            self._set_positions(self._context, np.asarray(q, float))
+        return self._calc_pose(self._context)
 
     def dynamics(self, q):
         """(X_WP, H (6, 6), J (6, 6) rows [w; v] of the probe in W) at q."""
-        self.set_positions(q)
-        H = self.plant.CalcMassMatrix(self._context)
-        J = self.plant.CalcJacobianSpatialVelocity(
-            self._context,
-            JacobianWrtVariable.kV,
-            self.frame,
-            self._p_origin,
-            self._world,
-            self._world,
+        context, world = self._context, self._world
+        self._set_positions(context, np.asarray(q, float))
+        H = self._calc_mass_matrix(context)
+        J = self._calc_jacobian(
+            context, self._kV, self.frame, self._p_origin, world, world
         )
-        return self.frame.CalcPoseInWorld(self._context), H, J
+        return self._calc_pose(context), H, J
+
+
+class FdccConstants(NamedTuple):
+    """The settings one tick reads, as plain floats (:meth:`from_params`)."""
+
+    internal_period_s: float
+    error_scale: float
+    p_gains: tuple  # 6 floats
+    d_gains: tuple  # 6 floats
+    rotational_stiffness: tuple  # 3 floats, N m/rad
+    velocity_decay: float
+    iterations: int
+    pose_from_command: bool  # pose_feedback == "command"
+    R_WP_target: RotationMatrix
+
+    @classmethod
+    def from_params(
+        cls, params: FdccParams, R_WP_target: RotationMatrix | None = None
+    ) -> "FdccConstants":
+        """From ``params`` (as they are now); R_WP_target defaults to params'."""
+        return cls(
+            float(params.internal_period_s),
+            float(params.error_scale),
+            tuple(np.asarray(params.p_gains, float).tolist()),
+            tuple(np.asarray(params.d_gains, float).tolist()),
+            tuple(np.asarray(params.rotational_stiffness_Nm_per_rad, float).tolist()),
+            float(params.velocity_decay),
+            int(params.iterations),
+            params.pose_feedback == "command",
+            params.R_WP_target if R_WP_target is None else R_WP_target,
+        )
 
 
 @dataclass(frozen=True)
@@ -250,6 +289,30 @@ class FdccStep:
     ok: bool
 
 
+def _array(name, value, n) -> np.ndarray:
+    """value as a new float64 array (n,), or a VicDrakeError naming the argument."""
+    a = np.array(value, float)
+    if a.shape != (n,):
+        raise VicDrakeError(f"{name} must be {n} numbers, got shape {a.shape}")
+    return a
+
+
+def _net_error(X_WP, x_d, R_d, K, K_rot, df) -> list:
+    """net_cartesian_error on floats: x_d, K, K_rot, df = f_t - f_m as 3 floats each."""
+    t0, t1, t2 = X_WP.translation().tolist()
+    aa = (R_d @ X_WP.rotation().inverse()).ToAngleAxis()
+    a0, a1, a2 = aa.axis().tolist()
+    angle = aa.angle()
+    return [
+        K[0] * (x_d[0] - t0) + df[0],
+        K[1] * (x_d[1] - t1) + df[1],
+        K[2] * (x_d[2] - t2) + df[2],
+        K_rot[0] * (a0 * angle),
+        K_rot[1] * (a1 * angle),
+        K_rot[2] * (a2 * angle),
+    ]
+
+
 def net_cartesian_error(
     X_WP,
     p_WP_target,
@@ -268,13 +331,115 @@ def net_cartesian_error(
         measured_force, target_force: sensor convention (negative z =
             pressing into the body), in W, N (3,).
     """
-    e_p = np.asarray(p_WP_target, float) - X_WP.translation()
-    aa = (R_WP_target @ X_WP.rotation().inverse()).ToAngleAxis()
-    e_R = aa.axis() * aa.angle()
-    force = np.asarray(stiffness, float) * e_p + (
-        np.asarray(target_force, float) - np.asarray(measured_force, float)
+    f_m = _array("measured_force", measured_force, 3).tolist()
+    f_t = _array("target_force", target_force, 3).tolist()
+    return np.array(
+        _net_error(
+            X_WP,
+            _array("p_WP_target", p_WP_target, 3).tolist(),
+            R_WP_target,
+            _array("stiffness", stiffness, 3).tolist(),
+            _array("rotational_stiffness", rotational_stiffness, 3).tolist(),
+            [f_t[0] - f_m[0], f_t[1] - f_m[1], f_t[2] - f_m[2]],
+        )
     )
-    return np.concatenate([force, np.asarray(rotational_stiffness, float) * e_R])
+
+
+def fdcc_tick(
+    model: FdccModel,
+    constants: FdccConstants,
+    q,
+    q_prev,
+    qdot,
+    last_error,
+    x_d,
+    stiffness,
+    measured_force,
+    target_force,
+):
+    """One FDCC tick (:func:`fdcc_step`) on float64 arrays; shapes are not checked.
+
+    Arguments as :func:`fdcc_step`'s, in its order, each a 1-D float64 array
+    of the right length; pure apart from ``model``'s scratch. Returns
+    ``(q_command, qdot, last_error)`` as lists of floats, or None on a fault
+    (an input or the result not finite, a negative stiffness, a singular
+    mass matrix): the caller then holds ``q_prev`` and zeroes the internal
+    velocity and error.
+    """
+    dt, scale, p_gains, d_gains, K_rot, decay, iterations, from_command, R_d = constants
+    qs = q.tolist()
+    qd = qdot.tolist()
+    err_prev = last_error.tolist()
+    xd = x_d.tolist()
+    K = stiffness.tolist()
+    f_m = measured_force.tolist()
+    f_t = target_force.tolist()
+    if not all(map(isfinite, qs + qd + err_prev + xd + K + f_m + f_t)) or (
+        min(K) < 0.0
+    ):
+        return None
+    df = [f_t[0] - f_m[0], f_t[1] - f_m[1], f_t[2] - f_m[2]]
+    p0, p1, p2, p3, p4, p5 = p_gains
+    d0, d1, d2, d3, d4, d5 = d_gains
+    for i in range(iterations):
+        X_WP, H, J = model.dynamics(q)
+        # The pose in the error: FZI's is the model's pose after the previous
+        # internal step (the last command; synchronising the joints does not
+        # update it), or optionally the measured pose.
+        if from_command and i == 0:
+            X_WP = model.pose(q_prev)
+        err = _net_error(X_WP, xd, R_d, K, K_rot, df)
+        # The PD on each component, its output ordered as Drake's [tau; f].
+        e0, e1, e2, e3, e4, e5 = err
+        g0, g1, g2, g3, g4, g5 = err_prev
+        u = np.array(
+            [
+                scale * (p3 * e3 + d3 * (e3 - g3) / dt),
+                scale * (p4 * e4 + d4 * (e4 - g4) / dt),
+                scale * (p5 * e5 + d5 * (e5 - g5) / dt),
+                scale * (p0 * e0 + d0 * (e0 - g0) / dt),
+                scale * (p1 * e1 + d1 * (e1 - g1) / dt),
+                scale * (p2 * e2 + d2 * (e2 - g2) / dt),
+            ]
+        )
+        err_prev = err
+        # qdd = H^-1 J^T u: LAPACK's LU solve, as np.linalg.solve.
+        _, _, qdd, info = dgesv(H, J.T.dot(u))
+        if info != 0:  # A singular mass matrix: hold, as for a non-finite result.
+            return None
+        a0, a1, a2, a3, a4, a5 = qdd.tolist()
+        v0, v1, v2, v3, v4, v5 = qd
+        x0, x1, x2, x3, x4, x5 = qs
+        qs = [
+            x0 + v0 * dt,
+            x1 + v1 * dt,
+            x2 + v2 * dt,
+            x3 + v3 * dt,
+            x4 + v4 * dt,
+            x5 + v5 * dt,
+        ]
+        qd = [
+            decay * (v0 + a0 * dt),
+            decay * (v1 + a1 * dt),
+            decay * (v2 + a2 * dt),
+            decay * (v3 + a3 * dt),
+            decay * (v4 + a4 * dt),
+            decay * (v5 + a5 * dt),
+        ]
+        for j, (lower, upper) in enumerate(model._limits):
+            if qs[j] < lower:
+                qs[j] = lower
+                if qd[j] < 0.0:
+                    qd[j] = 0.0
+            elif qs[j] > upper:
+                qs[j] = upper
+                if qd[j] > 0.0:
+                    qd[j] = 0.0
+        if i + 1 < iterations:
+            q = np.array(qs)
+    if not all(map(isfinite, qs + qd + err_prev)):
+        return None
+    return qs, qd, err_prev
 
 
 def fdcc_step(
@@ -305,50 +470,36 @@ def fdcc_step(
         measured_force, target_force: in W, sensor convention, N (3,).
         R_WP_target: the orientation target; default ``params.R_WP_target``
             (pass it to save rebuilding it every tick).
+
+    Raises:
+        VicDrakeError: an argument of the wrong length.
     """
-    q = np.asarray(q_measured, float)
-    qd = np.asarray(qdot, float)
-    err_prev = np.asarray(last_error, float)
-    x_d = np.asarray(p_WP_target, float)
-    K = np.asarray(stiffness, float)
-    f_m = np.asarray(measured_force, float)
-    f_t = np.asarray(target_force, float)
-    q_prev = np.asarray(q_command_prev, float)
-    # One vectorised check (this runs at 500 Hz).
-    inputs = np.concatenate([q, qd, err_prev, x_d, K, f_m, f_t])
-    if not np.isfinite(inputs).all() or (K < 0).any():
-        return FdccStep(q_prev.copy(), np.zeros(6), np.zeros(6), False)
-    dt = params.internal_period_s
-    p_gains = np.asarray(params.p_gains, float)
-    d_gains = np.asarray(params.d_gains, float)
-    R_d = params.R_WP_target if R_WP_target is None else R_WP_target
-    K_rot = np.asarray(params.rotational_stiffness_Nm_per_rad, float)
-    # The pose in the error: FZI's is the model's pose after the previous
-    # internal step (the last command; synchronising the joints does not
-    # update it), or optionally the measured pose.
-    q_pose = q_prev if params.pose_feedback == "command" else q
-    for _ in range(params.iterations):
-        X_WP, H, J = model.dynamics(q)
-        X_pose = X_WP if q_pose is q else model.pose(q_pose)
-        err = net_cartesian_error(X_pose, x_d, R_d, K, K_rot, f_m, f_t)
-        u = params.error_scale * (p_gains * err + d_gains * (err - err_prev) / dt)
-        err_prev = err
-        u_drake = np.concatenate([u[3:], u[:3]])  # [tau; f]
-        # LAPACK's LU solve, as np.linalg.solve (same result) without its
-        # wrapper's overhead (this runs at 500 Hz).
-        _, _, qdd, info = dgesv(H, J.T @ u_drake)
-        if info != 0:  # A singular mass matrix: hold, as for a non-finite result.
-            return FdccStep(q_prev.copy(), np.zeros(6), np.zeros(6), False)
-        q_next = q + qd * dt
-        qd = params.velocity_decay * (qd + qdd * dt)
-        below, above = q_next < model.q_lower, q_next > model.q_upper
-        if below.any() or above.any():
-            q_next = np.minimum(np.maximum(q_next, model.q_lower), model.q_upper)
-            qd[(below & (qd < 0)) | (above & (qd > 0))] = 0.0
-        q = q_pose = q_next
-    if not np.isfinite(np.concatenate([q, qd, err_prev])).all():
-        return FdccStep(q_prev.copy(), np.zeros(6), np.zeros(6), False)
-    return FdccStep(q, qd, err_prev, True)
+    arrays = [
+        _array(name, value, n)
+        for name, value, n in (
+            ("q_measured", q_measured, 6),
+            ("q_command_prev", q_command_prev, 6),
+            ("qdot", qdot, 6),
+            ("last_error", last_error, 6),
+            ("p_WP_target", p_WP_target, 3),
+            ("stiffness", stiffness, 3),
+            ("measured_force", measured_force, 3),
+            ("target_force", target_force, 3),
+        )
+    ]
+    result = fdcc_tick(model, FdccConstants.from_params(params, R_WP_target), *arrays)
+    if result is None:
+        return FdccStep(arrays[1], np.zeros(6), np.zeros(6), False)
+    q, qd, err = result
+    return FdccStep(np.array(q), np.array(qd), np.array(err), True)
 
 
-__all__ = ["FdccModel", "FdccParams", "FdccStep", "fdcc_step", "net_cartesian_error"]
+__all__ = [
+    "FdccConstants",
+    "FdccModel",
+    "FdccParams",
+    "FdccStep",
+    "fdcc_step",
+    "fdcc_tick",
+    "net_cartesian_error",
+]

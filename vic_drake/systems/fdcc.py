@@ -1,10 +1,11 @@
 """FdccController: the FDCC layer as a 500 Hz discrete LeafSystem.
 
-A thin adapter around :func:`vic_drake.control.fdcc.fdcc_step`. Every
-``FdccParams.period_s`` it reads its inputs, runs one FDCC tick and stores
-the joint position command, the internal joint velocity and the PD's last
-error in its discrete state. The CS, CF and variable-stiffness controllers
-all drive it through ``stiffness`` and ``target_force``.
+A thin adapter around :func:`vic_drake.control.fdcc.fdcc_tick` (the tick of
+:func:`vic_drake.control.fdcc.fdcc_step`). Every ``FdccParams.period_s`` it
+reads its inputs, runs one FDCC tick and stores the joint position command,
+the internal joint velocity and the PD's last error in its discrete state.
+The CS, CF and variable-stiffness controllers all drive it through
+``stiffness`` and ``target_force``.
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from pydrake.systems.framework import LeafSystem
 
-from vic_drake.control.fdcc import FdccModel, FdccParams, fdcc_step
+from vic_drake.control.fdcc import FdccConstants, FdccModel, FdccParams, fdcc_tick
 from vic_drake.errors import VicDrakeError
 from vic_drake.models.ur3e import MakeFdccModel
 
@@ -38,6 +39,8 @@ class FdccController(LeafSystem):
 
     State (discrete, updated every ``period_s``): the command q (6), the
     internal velocity (6) and the PD's last error (6), and the status (2).
+
+    The settings are read once, at construction.
     """
 
     def __init__(
@@ -59,6 +62,7 @@ class FdccController(LeafSystem):
             )
         self._model = MakeFdccModel(self._params, station_params)
         self._R_WP_target = self._params.R_WP_target
+        self._constants = FdccConstants.from_params(self._params, self._R_WP_target)
         q0 = np.zeros(6) if initial_q is None else np.asarray(initial_q, float)
         if q0.shape != (6,) or not np.all(np.isfinite(q0)):
             raise VicDrakeError(
@@ -79,6 +83,7 @@ class FdccController(LeafSystem):
             "position_command", self._q_cmd
         )
         self._status_port = self.DeclareStateOutputPort("status", self._status)
+        self._groups = (int(self._q_cmd), int(self._internal), int(self._status))
 
     @property
     def params(self) -> FdccParams:
@@ -116,26 +121,28 @@ class FdccController(LeafSystem):
         context.SetDiscreteState(self._internal, np.zeros(12))
 
     def _update(self, context, discrete_state):
-        internal = context.get_discrete_state(self._internal).get_value()
-        step = fdcc_step(
+        # Drake fills discrete_state with the current state before calling
+        # this handler: each group is read and written in place.
+        command, internal, status = map(discrete_state.get_mutable_value, self._groups)
+        result = fdcc_tick(
             self._model,
-            self._params,
-            q_measured=self._q_port.Eval(context),
-            q_command_prev=context.get_discrete_state(self._q_cmd).get_value(),
-            qdot=internal[:6],
-            last_error=internal[6:],
-            p_WP_target=self._target_port.Eval(context),
-            stiffness=self._stiffness_port.Eval(context),
-            measured_force=self._measured_port.Eval(context),
-            target_force=self._target_force_port.Eval(context),
-            R_WP_target=self._R_WP_target,
+            self._constants,
+            self._q_port.Eval(context),
+            command,
+            internal[:6],
+            internal[6:],
+            self._target_port.Eval(context),
+            self._stiffness_port.Eval(context),
+            self._measured_port.Eval(context),
+            self._target_force_port.Eval(context),
         )
-        status = context.get_discrete_state(self._status).get_value()
-        discrete_state.set_value(self._q_cmd, step.q_command)
-        discrete_state.set_value(
-            self._internal, np.concatenate([step.qdot, step.last_error])
-        )
-        discrete_state.set_value(
-            self._status,
-            [0.0 if step.ok else 1.0, status[1] + (0.0 if step.ok else 1.0)],
-        )
+        if result is None:  # Hold the command, stop the internal motion.
+            internal[:] = 0.0
+            status[0] = 1.0
+            status[1] = status[1] + 1.0
+        else:
+            q, qd, err = result
+            command[:] = q
+            internal[:] = qd + err
+            status[0] = 0.0
+            status[1] = status[1] + 0.0
