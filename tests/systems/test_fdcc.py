@@ -107,6 +107,24 @@ def test_nan_input_holds_the_command_and_flags(q_start):
     )
 
 
+def test_non_finite_command_is_refused_or_a_fault(q_start):
+    """A NaN command never reaches Drake's kinematics (which abort on it)."""
+    from dataclasses import replace
+
+    from vic_drake.errors import VicDrakeError
+
+    params = replace(FdccParams(), pose_feedback="command")
+    system = FdccController(params, station_params=StationParams(), initial_q=q_start)
+    context = system.CreateDefaultContext()
+    with pytest.raises(VicDrakeError, match="6 finite joint angles"):
+        system.set_initial_command(context, [np.nan] * 6)
+    _fix_inputs(system, context, q_start)
+    # A state set around the check: the tick is a fault, not an abort.
+    context.SetDiscreteState(0, np.full(6, np.nan))
+    context.SetDiscreteState(system.EvalUniquePeriodicDiscreteUpdate(context))
+    assert system.get_status_output_port().Eval(context)[0] == 1.0
+
+
 def _closed_loop(q0, station_params, *, target, stiffness, target_force):
     phantom = SyntheticChestPhantom()
     builder = DiagramBuilder()

@@ -378,6 +378,8 @@ def fdcc_tick(
         min(K) < 0.0
     ):
         return None
+    if from_command and not all(map(isfinite, q_prev.tolist())):
+        return None  # (Drake aborts on a non-finite position.)
     df = [f_t[0] - f_m[0], f_t[1] - f_m[1], f_t[2] - f_m[2]]
     p0, p1, p2, p3, p4, p5 = p_gains
     d0, d1, d2, d3, d4, d5 = d_gains

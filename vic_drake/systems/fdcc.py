@@ -117,7 +117,10 @@ class FdccController(LeafSystem):
 
     def set_initial_command(self, context, q) -> None:
         """Sets the command state to q (6,), rad, with zero internal motion."""
-        context.SetDiscreteState(self._q_cmd, np.asarray(q, float))
+        q = np.asarray(q, float)
+        if q.shape != (6,) or not np.all(np.isfinite(q)):
+            raise VicDrakeError(f"q must be 6 finite joint angles (rad), got {q!r}")
+        context.SetDiscreteState(self._q_cmd, q)
         context.SetDiscreteState(self._internal, np.zeros(12))
 
     def _update(self, context, discrete_state):
