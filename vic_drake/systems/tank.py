@@ -106,11 +106,9 @@ class EnergyTankSystem(LeafSystem):
         )
 
     def _calc_tank(self, context, output: BasicVector):
-        s = self._step(context)
-        # In the order of TANK_FIELDS.
-        output.SetFromVector(
-            [s.energy_J, s.power_W, s.sigma, 1.0 if s.enabled else 0.0]
-        )
+        energy, power, sigma, enabled = self._step(context)
+        # In the order of TANK_FIELDS, written through a numpy view.
+        output.get_mutable_value()[:] = (energy, power, sigma, 1.0 if enabled else 0.0)
 
     # "tank_energy" and the update read the cached "tank" output: one tank
     # step per tick.
@@ -118,9 +116,8 @@ class EnergyTankSystem(LeafSystem):
         output.SetAtIndex(0, self._tank_port.Eval(context)[TANK_ENERGY])
 
     def _update(self, context, discrete_state):
-        discrete_state.set_value(
-            self._state_index,
-            [tank_state(float(self._tank_port.Eval(context)[TANK_ENERGY]))],
+        discrete_state.get_mutable_value(self._state_index)[0] = tank_state(
+            float(self._tank_port.Eval(context)[TANK_ENERGY])
         )
 
     def get_qp_tick_input_port(self):
