@@ -88,9 +88,8 @@ class EnergyTankSystem(LeafSystem):
         )
 
     def _step(self, context) -> TankStep:
-        energy = tank_energy(
-            context.get_discrete_state(self._state_index).GetAtIndex(0)
-        )
+        # x_t is the only state group.
+        energy = tank_energy(context.get_discrete_state_vector().GetAtIndex(0))
         tick = self._tick_port.Eval(context).tolist()
         if tick[QP_TICK_ACTIVE] < 0.5:
             return TankStep(energy, 0.0, 0.0, False)
@@ -107,8 +106,8 @@ class EnergyTankSystem(LeafSystem):
 
     def _calc_tank(self, context, output: BasicVector):
         energy, power, sigma, enabled = self._step(context)
-        # In the order of TANK_FIELDS, written through a numpy view.
-        output.get_mutable_value()[:] = (energy, power, sigma, 1.0 if enabled else 0.0)
+        # In the order of TANK_FIELDS.
+        output.SetFromVector((energy, power, sigma, 1.0 if enabled else 0.0))
 
     # "tank_energy" and the update read the cached "tank" output: one tank
     # step per tick.
