@@ -200,6 +200,41 @@ def test_cs_and_cf(phantom):
     assert out(diagram, context, "status")[0] == 1.0
 
 
+def test_target_force_is_cf_only_and_zero_on_a_fault(phantom):
+    _, diagram, context = make(phantom, "cf")
+    diagram.GetInputPort("probe.velocity").FixValue(context, [0.0, math.nan, 0.0])
+    np.testing.assert_array_equal(out(diagram, context, "target_force"), [0.0] * 3)
+    diagram.GetInputPort("probe.velocity").FixValue(context, V_WP)
+    np.testing.assert_array_equal(
+        out(diagram, context, "target_force"), [0.0, 0.0, -7.0]
+    )
+    for controller in ("cs", "vs-cf", "vs-vf"):  # A constant zero, no feedthrough.
+        params = ControllerParams(reference=ReferenceParams(controller=controller))
+        system = ForceReferenceSystem(params, phantom=phantom)
+        port = system.get_target_force_output_port()
+        assert not any(
+            system.HasDirectFeedthrough(i, port.get_index())
+            for i in range(system.num_input_ports())
+        )
+        context = system.CreateDefaultContext()
+        system.get_probe_position_input_port().FixValue(context, P_WP)
+        system.get_probe_velocity_input_port().FixValue(context, V_WP)
+        system.get_measured_force_input_port().FixValue(context, F_W)
+        np.testing.assert_array_equal(port.Eval(context), [0.0] * 3)
+
+
+def test_qp_reads_the_tanks_energy(phantom):
+    _, diagram, context = make(phantom, "vs-vf")
+    qp = diagram.GetSubsystemByName("stiffness_qp")
+    tank = diagram.GetSubsystemByName("energy_tank")
+    for _ in range(3):
+        tick(diagram, context)
+        np.testing.assert_array_equal(
+            qp.GetInputPort("tank_energy").Eval(qp.GetMyContextFromRoot(context)),
+            tank.get_energy_output_port().Eval(tank.GetMyContextFromRoot(context)),
+        )
+
+
 def test_osqp_system_matches_exact_system(phantom):
     _, exact, c1 = make(phantom, "vs-vf")
     _, osqp, c2 = make(phantom, "vs-vf", qp=StiffnessQpParams())  # Default: OSQP.

@@ -41,3 +41,22 @@ def test_waypoint_target_interpolates_the_table():
     p = _eval_at(source, source.get_target_position_output_port(), 1.0)
     np.testing.assert_allclose(p, [-0.01, 0.0, 0.1])
     assert config.start_tip_z_m == 0.1 and config.end_time_s == 3.0
+
+
+def test_target_source_equals_its_trajectory_and_stops_at_the_end():
+    config = TrajectoryConfig()
+    source = TargetTrajectorySource(config)
+    t_knots, _ = target_knots(config)
+    t_end = float(t_knots[-1])
+    times = [*t_knots, *(0.5 * (t_knots[:-1] + t_knots[1:])), t_end + 3.0]
+    rate = source.trajectory.derivative(1)
+    for t in times:
+        np.testing.assert_array_equal(
+            _eval_at(source, source.get_target_position_output_port(), t),
+            source.trajectory.value(t).ravel(),
+        )
+        v = _eval_at(source, source.get_target_velocity_output_port(), t)
+        if t < t_end:  # The rate of the segment that starts at or before t.
+            np.testing.assert_array_equal(v, rate.value(t).ravel())
+        else:  # The target has stopped: zero at the end time and after.
+            np.testing.assert_array_equal(v, [0.0, 0.0, 0.0])

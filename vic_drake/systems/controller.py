@@ -7,7 +7,8 @@ named "variable_impedance_controller" composing
   rate, F_ref, F_min, the FDCC target force,
 - "stiffness_qp" (:class:`StiffnessQpSystem`): K (QP or constant), D,
   status, and the record of its tick ("qp_tick") the tank integrates,
-- "energy_tank" (:class:`EnergyTankSystem`): T, power, sigma, enabled,
+- "energy_tank" (:class:`EnergyTankSystem`): T, power, sigma, enabled
+  (its T reaches the QP through "tank_fields", a Demultiplexer),
 
 all at ``params.period_s`` (500 Hz by default). All four controllers (CS,
 CF, VS-CF, VS-VF) expose the same ports; see
@@ -18,13 +19,14 @@ CF, VS-CF, VS-VF) expose the same ports; see
 from __future__ import annotations
 
 from pydrake.systems.framework import Diagram, DiagramBuilder
+from pydrake.systems.primitives import Demultiplexer
 
 from vic_drake.control.params import ControllerParams
 from vic_drake.errors import VicDrakeError
 from vic_drake.estimation.online import OnlineEstimatorParams
 from vic_drake.systems.online_estimator import OnlineEstimatorSystem
 from vic_drake.systems.references import ForceReferenceSystem
-from vic_drake.systems.signals import STATUS_FIELDS, TANK_FIELDS
+from vic_drake.systems.signals import STATUS_FIELDS, TANK_ENERGY, TANK_FIELDS
 from vic_drake.systems.stiffness_qp import StiffnessQpSystem
 from vic_drake.systems.tank import EnergyTankSystem
 from vic_drake.tissue.phantom import Phantom
@@ -131,7 +133,15 @@ def MakeVariableImpedanceController(
         builder.ConnectInput(index, est.GetInputPort("ft_sensor.force_W"))
 
     builder.Connect(ref.get_references_output_port(), qp.GetInputPort("references"))
-    builder.Connect(tank.get_energy_output_port(), qp.GetInputPort("tank_energy"))
+    # The QP reads T from the "tank" record through a C++ Demultiplexer: the
+    # number of the tank's own "tank_energy" port, with no Python call per tick.
+    tank_fields = builder.AddNamedSystem(
+        "tank_fields", Demultiplexer(len(TANK_FIELDS), 1)
+    )
+    builder.Connect(tank.get_tank_output_port(), tank_fields.get_input_port())
+    builder.Connect(
+        tank_fields.get_output_port(TANK_ENERGY), qp.GetInputPort("tank_energy")
+    )
     builder.Connect(qp.get_qp_tick_output_port(), tank.get_qp_tick_input_port())
 
     builder.ExportOutput(qp.get_stiffness_output_port(), "stiffness")

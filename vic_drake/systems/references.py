@@ -8,9 +8,10 @@ and the QP and FDCC read them within the same tick). The periodic discrete
 update at the controller rate advances the surface-velocity filter and
 stores the tick's values, which the "force_reference", "force_min" and
 "contact" ports publish from state: what the QP used at the last tick
-(loggers read them after the tick's update without recomputing). The
-packed "references" and "contact" layouts are in
-:mod:`vic_drake.systems.signals`.
+(loggers read them after the tick's update without recomputing). Only CF
+has a nonzero target force; for the other controllers "target_force" is a
+constant zero, computed once. The packed "references" and "contact" layouts
+are in :mod:`vic_drake.systems.signals`.
 """
 
 from __future__ import annotations
@@ -51,6 +52,19 @@ from vic_drake.tissue.phantom import Phantom
 
 #: The map sample of a faulty tick (no lookup was made).
 _NO_SAMPLE = (math.nan, math.nan)
+#: The cached tick (one array): the references, the tick record, the new
+#: surface-velocity filter state.
+_REFERENCES = slice(0, REFERENCES_SIZE)
+_RECORD = slice(REFERENCES_SIZE, REFERENCES_SIZE + TICK_RECORD_SIZE)
+_FILTER_START = _RECORD.stop
+_ESTIMATE_KAPPA = ESTIMATE_FIELDS.index("kappa_hat")
+_ESTIMATE_LAMBDA = ESTIMATE_FIELDS.index("lambda_hat")
+_ESTIMATE_SURFACE_Z = ESTIMATE_FIELDS.index("surface_z_m")
+
+
+def _array(values: list) -> np.ndarray:
+    """The floats of a list as an array (np.fromiter: cheaper than np.array)."""
+    return np.fromiter(values, float, len(values))
 
 
 class ForceReferenceSystem(LeafSystem):
@@ -62,7 +76,8 @@ class ForceReferenceSystem(LeafSystem):
         ft_sensor.force_W (3): F/T force in W, N, sensor convention.
 
     Output ports (direct feedthrough of the current inputs):
-        target_force (3): force the FDCC stage tracks, N (CF only).
+        target_force (3): force the FDCC stage tracks, N (CF only; a
+            constant zero, without feedthrough, for CS, VS-CF and VS-VF).
         references (13): F_ref, F_min, target force, contact (layout
             :data:`vic_drake.systems.signals.REFERENCES_SIZE` and the
             ``REF_*`` slices), read by StiffnessQpSystem in one port
@@ -128,7 +143,7 @@ class ForceReferenceSystem(LeafSystem):
             self._sample = scalar_sampler(phantom)
         self._dt = float(params.period_s)
         ref = params.reference
-        self._mode = ref.surface_velocity_mode
+        self._moving_average = ref.surface_velocity_mode == "moving_average"
         self._position_port = self.DeclareVectorInputPort("probe.position", 3)
         self._velocity_port = self.DeclareVectorInputPort("probe.velocity", 3)
         self._force_port = self.DeclareVectorInputPort("ft_sensor.force_W", 3)
@@ -137,130 +152,142 @@ class ForceReferenceSystem(LeafSystem):
             if self._online
             else None
         )
-        self._filter_index = self.DeclareDiscreteState(
-            surface_velocity_initial_state(ref.surface_velocity_window)
-        )
+        filter_state = surface_velocity_initial_state(ref.surface_velocity_window)
+        self._filter_index = self.DeclareDiscreteState(filter_state)
         self.DeclarePeriodicDiscreteUpdateEvent(self._dt, 0.0, self._update)
+        # The tick's values, one array (see _evaluate).
         self._cache = self.DeclareCacheEntry(
             "references",
             ValueProducer(
                 allocate=lambda: AbstractValue.Make(object()), calc=self._calc
             ),
-            {self.all_input_ports_ticket(), self.xd_ticket()},
+            {
+                self.all_input_ports_ticket(),
+                self.discrete_state_ticket(self._filter_index),
+            },
         )
         self._outputs = {}
-        for name, part in (
-            ("target_force", REF_TARGET_FORCE),
-            ("references", slice(0, REFERENCES_SIZE)),
-        ):
-            self._outputs[name] = self.DeclareVectorOutputPort(
-                name,
-                part.stop - part.start,
-                self._make_output(part),
-                {self._cache.ticket()},
+        if ref.controller == "cf":
+            self._outputs["target_force"] = self.DeclareVectorOutputPort(
+                "target_force", 3, self._calc_target_force, {self._cache.ticket()}
             )
-        self._last = {}
+        else:  # Zero at every tick, faulty or not.
+            self._outputs["target_force"] = self.DeclareVectorOutputPort(
+                "target_force",
+                3,
+                lambda context, output: output.SetZero(),
+                {self.nothing_ticket()},
+            )
+        self._outputs["references"] = self.DeclareVectorOutputPort(
+            "references",
+            REFERENCES_SIZE,
+            self._calc_references,
+            {self._cache.ticket()},
+        )
+        # (state group, its slice of the cached tick): every group, all
+        # written by the update.
+        self._state_parts = [
+            (
+                self._filter_index,
+                slice(_FILTER_START, _FILTER_START + len(filter_state)),
+            )
+        ]
         for name, part in (
             ("force_reference", REF_FORCE_REFERENCE),
             ("force_min", REF_FORCE_MIN),
             ("contact", REF_CONTACT),
+            ("tick_record", _RECORD),
         ):
-            self._last[name] = (self.DeclareDiscreteState(part.stop - part.start), part)
-            self._outputs[name] = self.DeclareStateOutputPort(name, self._last[name][0])
-        self._record_index = self.DeclareDiscreteState(
-            np.full(TICK_RECORD_SIZE, np.nan)
-        )
-        self._outputs["tick_record"] = self.DeclareStateOutputPort(
-            "tick_record", self._record_index
-        )
+            initial = np.nan if name == "tick_record" else 0.0
+            index = self.DeclareDiscreteState(np.full(part.stop - part.start, initial))
+            self._state_parts.append((index, part))
+            self._outputs[name] = self.DeclareStateOutputPort(name, index)
+        # Scratch for the update: filled through numpy views of its groups,
+        # then copied into the update's result with one SetFrom. Only the
+        # update uses it, and it overwrites all of it each time.
+        self._scratch = self.AllocateDiscreteVariables()
+        self._scratch_views = [
+            (self._scratch.get_mutable_value(index), part)
+            for index, part in self._state_parts
+        ]
+        # The references of a faulty tick: zero F_ref, F_min,z = -F_max,z,
+        # fault.
+        qp = params.qp
+        safe = [0.0] * REFERENCES_SIZE
+        safe[REF_FORCE_MIN] = (qp.force_min_N[0], qp.force_min_N[1], -qp.force_max_N[2])
+        safe[REF_FAULT] = 1.0
+        self._safe_values = safe
 
-    def _make_output(self, part: slice):
-        def calc(context, output: BasicVector):
-            output.SetFromVector(self._cache.Eval(context)[0][part])
+    def _calc_references(self, context, output: BasicVector):
+        output.set_value(self._cache.Eval(context)[_REFERENCES])
 
-        return calc
+    def _calc_target_force(self, context, output: BasicVector):
+        output.set_value(self._cache.Eval(context)[REF_TARGET_FORCE])
 
-    def _safe_values(self) -> np.ndarray:
-        """The references of a faulty tick: zero F_ref, F_min,z = -F_max,z, fault."""
-        qp = self._params.qp
-        values = np.zeros(REFERENCES_SIZE)
-        values[REF_FORCE_MIN] = (
-            qp.force_min_N[0],
-            qp.force_min_N[1],
-            -qp.force_max_N[2],
-        )
-        values[REF_FAULT] = 1.0
-        return values
-
-    def _evaluate(self, context):
-        """(values (REFERENCES_SIZE,), new filter state, tick record) now."""
+    def _evaluate(self, context) -> np.ndarray:
+        """The tick now, as one array: the references (``_REFERENCES``), the
+        tick record (``_RECORD``), then the new filter state."""
         p_WP = self._position_port.Eval(context).tolist()
         v_WP = self._velocity_port.Eval(context).tolist()
         f_W = self._force_port.Eval(context).tolist()
         filt = context.get_discrete_state(self._filter_index).value().tolist()
-        ref, qp = self._params.reference, self._params.qp
         # A sum of floats is finite iff every term is (inf - inf = nan).
         if not math.isfinite(sum(p_WP) + sum(v_WP) + sum(f_W)):
             # Restart the filter: the next good sample only records its height
             # (no rate spike across the gap).
-            return (
-                self._safe_values(),
-                [0.0, *filt[1:]],
-                [*p_WP, *v_WP, *f_W, *_NO_SAMPLE],
-            )
+            filt[0] = 0.0
+            return _array([*self._safe_values, *p_WP, *v_WP, *f_W, *_NO_SAMPLE, *filt])
         if self._online:
-            est = self._estimate_port.Eval(context)
-            kappa = float(est[0])
-            lam = float(est[1])
-            surface_z = float(est[ESTIMATE_FIELDS.index("surface_z_m")])
+            est = self._estimate_port.Eval(context).tolist()
+            kappa = est[_ESTIMATE_KAPPA]
+            lam = est[_ESTIMATE_LAMBDA]
+            surface_z = est[_ESTIMATE_SURFACE_Z]
             dz_dx = dz_dy = 0.0
         else:
             surface_z, dz_dx, dz_dy, kappa, lam = self._sample(p_WP[0], p_WP[1])
+        restart = False
         if not math.isfinite(surface_z):  # Online, before contact: no surface.
             # Zero penetration and rate; restart the filter so that the
             # surface latched at contact is not read as a jump.
-            filt = [0.0, *filt[1:]]
+            filt[0] = 0.0
             surface_z, dz_dx, dz_dy = p_WP[2], 0.0, 0.0
-            if self._mode == "moving_average":
-                filt[0] = -1.0  # Marks "restart after this tick" (below).
-        if self._mode == "moving_average" and filt[0] < 0.0:
-            new_filt, z_surf_dot = [0.0, *filt[1:]], 0.0
-        elif self._mode == "moving_average":
-            new_filt, z_surf_dot = surface_velocity_step(filt, surface_z, self._dt)
-        else:
-            new_filt = filt
+            restart = True
+        if not self._moving_average:
             z_surf_dot = surface_velocity_gradient(dz_dx, dz_dy, v_WP[0], v_WP[1])
+        elif restart:
+            z_surf_dot = 0.0
+        else:
+            filt, z_surf_dot = surface_velocity_step(filt, surface_z, self._dt)
+        ref = self._params.reference
         contact = in_contact(f_W[2], ref)
-        refs = force_references(
+        f_ref, f_min, target = force_references(
             contact=contact,
             kappa=kappa,
             lam=lam,
             eps_dot=penetration_rate(v_WP[2], z_surf_dot),
             beta=self._beta,
             ref=ref,
-            qp=qp,
+            qp=self._params.qp,
         )
         values = [0.0] * REFERENCES_SIZE  # A list: cheaper than numpy per element.
-        values[REF_FORCE_REFERENCE] = refs.force_ref
-        values[REF_FORCE_MIN] = refs.force_min
-        values[REF_TARGET_FORCE] = refs.target_force
+        values[REF_FORCE_REFERENCE] = f_ref
+        values[REF_FORCE_MIN] = f_min
+        values[REF_TARGET_FORCE] = target
         values[REF_IN_CONTACT] = 1.0 if contact else 0.0
         values[REF_PENETRATION] = penetration(surface_z, p_WP[2])
-        values[REF_FAULT] = 0.0
-        values[REF_SURFACE_VELOCITY] = z_surf_dot
+        values[REF_SURFACE_VELOCITY] = z_surf_dot  # REF_FAULT stays 0.
         if not math.isfinite(sum(values)):  # E.g. a phantom returning NaN.
-            return self._safe_values(), new_filt, [*p_WP, *v_WP, *f_W, *_NO_SAMPLE]
-        return np.array(values), new_filt, [*p_WP, *v_WP, *f_W, kappa, lam]
+            return _array([*self._safe_values, *p_WP, *v_WP, *f_W, *_NO_SAMPLE, *filt])
+        return _array([*values, *p_WP, *v_WP, *f_W, kappa, lam, *filt])
 
     def _calc(self, context, value):
         value.set_value(self._evaluate(context))
 
     def _update(self, context, discrete_state):
-        values, new_filt, record = self._cache.Eval(context)
-        discrete_state.set_value(self._filter_index, new_filt)
-        discrete_state.set_value(self._record_index, record)
-        for index, part in self._last.values():
-            discrete_state.set_value(index, values[part])
+        tick = self._cache.Eval(context)
+        for view, part in self._scratch_views:
+            view[:] = tick[part]
+        discrete_state.SetFrom(self._scratch)
 
     def get_probe_position_input_port(self):
         return self._position_port

@@ -88,9 +88,8 @@ class EnergyTankSystem(LeafSystem):
         )
 
     def _step(self, context) -> TankStep:
-        energy = tank_energy(
-            context.get_discrete_state(self._state_index).GetAtIndex(0)
-        )
+        # x_t is the only state group.
+        energy = tank_energy(context.get_discrete_state_vector().GetAtIndex(0))
         tick = self._tick_port.Eval(context).tolist()
         if tick[QP_TICK_ACTIVE] < 0.5:
             return TankStep(energy, 0.0, 0.0, False)
@@ -106,11 +105,9 @@ class EnergyTankSystem(LeafSystem):
         )
 
     def _calc_tank(self, context, output: BasicVector):
-        s = self._step(context)
+        energy, power, sigma, enabled = self._step(context)
         # In the order of TANK_FIELDS.
-        output.SetFromVector(
-            [s.energy_J, s.power_W, s.sigma, 1.0 if s.enabled else 0.0]
-        )
+        output.SetFromVector((energy, power, sigma, 1.0 if enabled else 0.0))
 
     # "tank_energy" and the update read the cached "tank" output: one tank
     # step per tick.
@@ -118,9 +115,8 @@ class EnergyTankSystem(LeafSystem):
         output.SetAtIndex(0, self._tank_port.Eval(context)[TANK_ENERGY])
 
     def _update(self, context, discrete_state):
-        discrete_state.set_value(
-            self._state_index,
-            [tank_state(float(self._tank_port.Eval(context)[TANK_ENERGY]))],
+        discrete_state.get_mutable_value(self._state_index)[0] = tank_state(
+            float(self._tank_port.Eval(context)[TANK_ENERGY])
         )
 
     def get_qp_tick_input_port(self):

@@ -6,7 +6,7 @@ them as ports:
 
 - :class:`TargetTrajectorySource`: outputs "target_position" (3, m) and
   "target_velocity" (3, m/s) of a piecewise-linear target (a first-order-hold
-  ``PiecewisePolynomial``).
+  ``PiecewisePolynomial``), evaluated by Drake's C++ ``TrajectorySource``.
 - :class:`PhantomLiftSource`: output "phantom_lift" (1, m), the vertical
   offset of the phantom (0 in nominal runs).
 
@@ -19,7 +19,8 @@ this one, so they are read by their fields (checked here), not imported.
 from __future__ import annotations
 
 import numpy as np
-from pydrake.systems.framework import BasicVector, LeafSystem
+from pydrake.systems.framework import BasicVector, Diagram, DiagramBuilder, LeafSystem
+from pydrake.systems.primitives import TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
 from vic_drake.errors import VicDrakeError
@@ -107,12 +108,35 @@ def phantom_lift_m(t_s, config) -> np.ndarray:
     return z
 
 
-class TargetTrajectorySource(LeafSystem):
+def _velocity_trajectory(position: PiecewisePolynomial) -> PiecewisePolynomial:
+    """The rate of ``position`` (piecewise constant), zero from its end time on.
+
+    The derivative's segments followed by a zero segment [t_end, t_end + 1 s]:
+    a break belongs to the segment it starts and a ``PiecewisePolynomial``
+    holds its last segment past its end, so the value is zero at t_end and
+    after.
+    """
+    velocity = position.derivative(1)
+    t_end = position.end_time()
+    velocity.ConcatenateInTime(
+        PiecewisePolynomial.ZeroOrderHold(
+            [t_end, t_end + 1.0], np.zeros((position.rows(), 2))
+        )
+    )
+    return velocity
+
+
+class TargetTrajectorySource(Diagram):
     """The scan target x_d(t) from a :class:`TrajectoryConfig`.
 
+    A Diagram of two C++ ``TrajectorySource`` systems ("position" and
+    "velocity"): no Python runs when its outputs are evaluated.
+
     Output ports:
-        target_position: (3,) x_d in W, m.
-        target_velocity: (3,) its rate in W, m/s (piecewise constant).
+        target_position: (3,) x_d in W, m (held at the last knot after the
+            end).
+        target_velocity: (3,) its rate in W, m/s (piecewise constant; zero
+            from the end time on).
     """
 
     def __init__(self, config):
@@ -122,14 +146,18 @@ class TargetTrajectorySource(LeafSystem):
         )
         t, p = target_knots(config)
         self._trajectory = PiecewisePolynomial.FirstOrderHold(t, p)
-        self._velocity = self._trajectory.derivative(1)
-        self._t_end = float(t[-1])
-        self._position_port = self.DeclareVectorOutputPort(
-            "target_position", BasicVector(3), self._calc_position
+        builder = DiagramBuilder()
+        position = builder.AddNamedSystem(
+            "position", TrajectorySource(self._trajectory)
         )
-        self._velocity_port = self.DeclareVectorOutputPort(
-            "target_velocity", BasicVector(3), self._calc_velocity
+        velocity = builder.AddNamedSystem(
+            "velocity", TrajectorySource(_velocity_trajectory(self._trajectory))
         )
+        builder.ExportOutput(position.get_output_port(), "target_position")
+        builder.ExportOutput(velocity.get_output_port(), "target_velocity")
+        builder.BuildInto(self)
+        self._position_port = self.GetOutputPort("target_position")
+        self._velocity_port = self.GetOutputPort("target_velocity")
 
     @property
     def trajectory(self):
@@ -141,16 +169,6 @@ class TargetTrajectorySource(LeafSystem):
 
     def get_target_velocity_output_port(self):
         return self._velocity_port
-
-    def _calc_position(self, context, output):
-        output.SetFromVector(self._trajectory.value(context.get_time()).ravel())
-
-    def _calc_velocity(self, context, output):
-        t = context.get_time()
-        if t >= self._t_end:
-            output.SetFromVector(np.zeros(3))
-        else:
-            output.SetFromVector(self._velocity.value(t).ravel())
 
 
 class PhantomLiftSource(LeafSystem):
