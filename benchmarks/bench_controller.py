@@ -1,14 +1,20 @@
-"""Per-tick cost of the online controller (reference + stiffness QP + tank).
+"""Per-tick cost of the online controller (reference + stiffness QP + tank), per QP solver.
 
-Prints median and p99 wall time per tick, in microseconds, against the
-2,000 us of a 500 Hz loop, for
+Prints, with the Drake and Python versions, median and p99 wall time per
+tick, in microseconds, against the 2,000 us of a 500 Hz loop, for
 
-- the pure functions of one tick (phantom lookup, references, QP, tank),
-  with the exact solver and through the MathematicalProgram (OSQP,
-  Clarabel);
-- the Drake Diagram ``MakeVariableImpedanceController`` advanced by a
-  Simulator (inputs fixed, 500 Hz events of its three LeafSystems), the same
-  three solvers.
+- the function path: the pure functions of one tick (phantom lookup,
+  references, QP, tank), with the exact solver and through the
+  MathematicalProgram with every Drake solver of
+  ``vic_drake.control.stiffness_qp.program.PROGRAM_SOLVERS`` (OSQP,
+  Clarabel, SCS, Clp, NLopt, SNOPT, IPOPT), each one's largest distance
+  to the exact solver's K on the same ticks and its failed ticks;
+- the Diagram path: ``MakeVariableImpedanceController`` advanced by a
+  Simulator (inputs fixed, 500 Hz events of its three LeafSystems), for the
+  solvers a scenario can select (exact, OSQP, Clarabel);
+
+then a summary table per solver (the figure of issue 14: function-path QP
+median and p99, Diagram-path tick p99, accuracy).
 
 Each figure is given in wall time (what a real-time loop sees) and in the
 thread's CPU time (``time.thread_time``), which excludes the time the thread
@@ -17,18 +23,23 @@ set by preemptions (several ms at a load above the core count), the CPU-time
 p99 by the code.
 
 The inputs replay the real log ``test_nardi_matForce_lowR`` (VS-VF) when the
-data is present, else a synthetic scan. Goals (issue): p99 <= 200 us through
-the MathematicalProgram, <= 30 us exact. No asserts: this prints figures.
+data is present, else a synthetic scan. Goals (issue 14): Diagram-path tick
+p99 <= 200 us through the MathematicalProgram. No asserts: this prints
+figures.
 
 Usage:
-    python benchmarks/bench_controller.py [--ticks N] [--phantom synthetic|measured]
+    python benchmarks/bench_controller.py [--ticks N] [--diagram-ticks N]
+        [--phantom synthetic|measured] [--repeats N] [--solvers exact,osqp,...]
+        [--other-ticks N]
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib.metadata
 import math
 import os
+import platform
 import time
 
 import numpy as np
@@ -46,12 +57,28 @@ from vic_drake.control.references import (
     surface_velocity_initial_state,
     surface_velocity_step,
 )
-from vic_drake.control.stiffness_qp import StiffnessQp, make_stiffness_qp_problem
+from vic_drake.control.stiffness_qp import (
+    StiffnessQp,
+    make_stiffness_qp_problem,
+    solve_stiffness_qp_exact,
+)
+from vic_drake.control.stiffness_qp.program import PROGRAM_SOLVERS
 from vic_drake.control.tank import tank_step
 from vic_drake.paths import has_data, resolve_data_dir
 from vic_drake.tissue.phantom import load_phantom
 
 LOOP_US = 2000.0
+#: The solvers a scenario can select (StiffnessQpParams.solver): the Diagram
+#: path is measured for these.
+SCENARIO_SOLVERS = ("exact", "osqp", "clarabel")
+
+
+def versions() -> str:
+    """Drake and Python versions, printed with every figure."""
+    return (
+        f"drake {importlib.metadata.version('drake')}, "
+        f"python {platform.python_version()}, numpy {np.__version__}"
+    )
 
 
 def inputs(n: int, phantom):
@@ -80,10 +107,28 @@ def inputs(n: int, phantom):
     return "synthetic scan", p, v, xd, f
 
 
-def stats(samples_s) -> str:
+def median_p99(samples_s) -> tuple[float, float]:
+    """Median and 99th percentile of samples in seconds, in microseconds."""
     us = np.asarray(samples_s) * 1e6
-    med, p99 = np.median(us), np.percentile(us, 99)
+    return float(np.median(us)), float(np.percentile(us, 99))
+
+
+def stats(samples_s) -> str:
+    med, p99 = median_p99(samples_s)
     return f"median {med:8.1f} us  p99 {p99:8.1f} us  ({100 * p99 / LOOP_US:5.1f}% of 2 ms)"
+
+
+def controller_params(solver: str) -> ControllerParams:
+    """VS-VF at R = 1e-5 (the replayed log's settings) with the given QP solver.
+
+    Solvers a scenario cannot select are built as "osqp" here: the function
+    path constructs its own :class:`StiffnessQp`.
+    """
+    qp_solver = solver if solver in SCENARIO_SOLVERS else "osqp"
+    return ControllerParams(
+        qp=StiffnessQpParams(r_weight=[1e-5] * 3, solver=qp_solver),
+        reference=ReferenceParams(controller="vs-vf"),
+    )
 
 
 def bench_functions(
@@ -95,6 +140,11 @@ def bench_functions(
     state and the fastest time is kept: this removes the multi-millisecond
     preemptions of a shared machine from the p99 (the raw figure, repeats =
     1, keeps them).
+
+    Returns:
+        (tick times, QP times, tick thread-CPU times, largest |K - K_exact|
+        in N/m over the ticks, number of failed solves); the exact solver's
+        K is computed on the same problem outside the timed section.
     """
     ref, qp, tank = params.reference, params.qp, params.tank
     dt = params.period_s
@@ -105,6 +155,7 @@ def bench_functions(
     energy, k_prev = tank.initial_energy_J, k_min
     zeta = qp.damping_ratio
     times, qp_times, cpu_times = [], [], []
+    worst, failed = 0.0, 0
     p_all, v_all, xd_all, f_all = (r.tolist() for r in rows)
     for p, v, xd, f in zip(p_all, v_all, xd_all, f_all):
         best = best_qp = best_cpu = math.inf
@@ -123,11 +174,13 @@ def bench_functions(
             d = (2 * zeta * math.sqrt(k_prev[0]), 2 * zeta * math.sqrt(k_prev[1]),
                  2 * zeta * math.sqrt(k_prev[2]))  # fmt: skip
             t1 = time.perf_counter()
+            problem = None
             if energy >= tank.min_energy_J:
                 problem = make_stiffness_qp_problem(
                     e, e_dot, d, refs.force_ref, refs.force_min, energy, dt, qp, tank
                 )
-                k = qp_solver.solve(problem, guess=k_prev).stiffness
+                sol = qp_solver.solve(problem, guess=k_prev)
+                k = sol.stiffness
             else:
                 k = k_min
             t2 = time.perf_counter()
@@ -137,11 +190,15 @@ def bench_functions(
             best = min(best, t3 - t0)
             best_qp = min(best_qp, t2 - t1)
             best_cpu = min(best_cpu, c3 - c0)
+        if problem is not None:
+            failed += not sol.success
+            k_exact = solve_stiffness_qp_exact(problem).stiffness
+            worst = max(worst, *(abs(a - b) for a, b in zip(k, k_exact)))
         filt, energy, k_prev = new_filt, new_energy, k
         times.append(best)
         qp_times.append(best_qp)
         cpu_times.append(best_cpu)
-    return times, qp_times, cpu_times
+    return times, qp_times, cpu_times, worst, failed
 
 
 def bench_diagram(params: ControllerParams, phantom, rows, ticks: int):
@@ -179,10 +236,26 @@ def main():
         "--repeats", type=int, default=3,
         help="function path: best of N computations of each tick (1 = raw)",
     )  # fmt: skip
+    parser.add_argument(
+        "--solvers", default=",".join(("exact",) + PROGRAM_SOLVERS),
+        help="comma-separated QP solvers (default: exact and every Drake solver)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--other-ticks", type=int, default=500,
+        help="function-path ticks for solvers a scenario cannot select (IPOPT: ~5 ms each)",
+    )  # fmt: skip
     args = parser.parse_args()
+    solvers = [name.strip() for name in args.solvers.split(",") if name.strip()]
+    for name in solvers:
+        if name != "exact" and name not in PROGRAM_SOLVERS:
+            parser.error(
+                f"--solvers: unknown solver {name!r}; "
+                f"choose from {', '.join(('exact',) + PROGRAM_SOLVERS)}"
+            )
     kind = args.phantom or ("measured" if has_data() else "synthetic")
     phantom = load_phantom(kind)
     source, *rows = inputs(args.ticks, phantom)
+    print(versions())
     print(
         f"inputs: {source}, {len(rows[0])} ticks; phantom: {kind}; loop budget {LOOP_US:.0f} us"
     )
@@ -190,29 +263,56 @@ def main():
     print(
         f"machine: {os.cpu_count()} CPUs, 1-min load average {load:.2f} (contention inflates p99)"
     )
-    print("-- pure functions, one tick = phantom lookup + references + QP + tank")
-    for solver in ("exact", "osqp", "clarabel"):
-        params = ControllerParams(
-            qp=StiffnessQpParams(r_weight=[1e-5] * 3, solver=solver),
-            reference=ReferenceParams(controller="vs-vf"),
-        )
+    summary = {}
+    print("-- function path: one tick = phantom lookup + references + QP + tank")
+    for solver in solvers:
+        params = controller_params(solver)
+        n = len(rows[0]) if solver in SCENARIO_SOLVERS else args.other_ticks
+        solver_rows = [r[:n] for r in rows]
         for repeats in sorted({1, args.repeats}):
-            total, qp_only, cpu = bench_functions(
-                params, phantom, rows, solver, repeats
+            total, qp_only, cpu, worst, failed = bench_functions(
+                params, phantom, solver_rows, solver, repeats
             )
             tag = "raw" if repeats == 1 else f"best of {repeats}"
-            print(f"{solver:9s} tick  {stats(total)}  [wall, {tag}]")
+            print(f"{solver:9s} tick  {stats(total)}  [wall, {tag}, {n} ticks]")
             print(f"{solver:9s} tick  {stats(cpu)}  [thread CPU, {tag}]")
             print(f"{solver:9s} QP    {stats(qp_only)}  [wall, {tag}]")
-    print("-- Diagram (3 LeafSystems, Simulator.AdvanceTo one period per tick)")
-    for solver in ("exact", "osqp", "clarabel"):
-        params = ControllerParams(
-            qp=StiffnessQpParams(r_weight=[1e-5] * 3, solver=solver),
-            reference=ReferenceParams(controller="vs-vf"),
+            if repeats == args.repeats:  # The summary's figures: best of N.
+                summary[solver] = [*median_p99(total), *median_p99(qp_only)]
+                summary[solver] += [math.nan, math.nan, math.nan, worst, failed, n]
+        print(
+            f"{solver:9s} max |K - K_exact| {worst:.1e} N/m, "
+            f"{failed} failed solve(s) in {n} ticks"
         )
-        wall, cpu = bench_diagram(params, phantom, rows, args.diagram_ticks)
+    print("-- Diagram path (3 LeafSystems, Simulator.AdvanceTo one period per tick)")
+    for solver in solvers:
+        if solver not in SCENARIO_SOLVERS:
+            continue
+        wall, cpu = bench_diagram(
+            controller_params(solver), phantom, rows, args.diagram_ticks
+        )
         print(f"{solver:9s} tick  {stats(wall)}  [wall]")
         print(f"{solver:9s} tick  {stats(cpu)}  [thread CPU]")
+        summary[solver][4:7] = [*median_p99(wall), median_p99(cpu)[1]]
+    tag = "raw" if args.repeats == 1 else f"best of {args.repeats}"
+    print(f"-- summary per solver, us ({versions()})")
+    print(f"{'':9s} {'function path (wall, ' + tag + ')':^38s}  {'Diagram path':^27s}")
+    print(
+        f"{'solver':9s} {'tick med':>9s} {'tick p99':>9s} {'QP med':>9s} {'QP p99':>9s}  "
+        f"{'med wall':>8s} {'p99 wall':>8s} {'p99 CPU':>8s}  {'max|K-K_exact|':>14s} "
+        f"{'failed':>9s}"
+    )
+    for solver, figures in summary.items():
+        t_med, t_p99, q_med, q_p99, d_med, d_p99, d_cpu, worst, failed, n = figures
+        diagram = "  ".join(
+            f"{v:8.1f}" if not math.isnan(v) else f"{'n/a':>8s}"
+            for v in (d_med, d_p99, d_cpu)
+        )
+        print(
+            f"{solver:9s} {t_med:9.1f} {t_p99:9.1f} {q_med:9.1f} {q_p99:9.1f}  "
+            f"{diagram}  {worst:10.1e} N/m {failed:4d}/{n:<4d}"
+        )
+    print("(Diagram path n/a: a scenario cannot select that solver.)")
 
 
 if __name__ == "__main__":

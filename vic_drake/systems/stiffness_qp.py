@@ -39,6 +39,11 @@ from vic_drake.systems.signals import (
     STATUS_QP_OK,
 )
 
+_STATUS_FAULT = STATUS_FIELDS.index("fault")
+_STATUS_IN_CONTACT = STATUS_FIELDS.index("in_contact")
+_STATUS_SOLVE_TIME = STATUS_FIELDS.index("solve_time_s")
+_STATUS_PENETRATION = STATUS_FIELDS.index("penetration_m")
+
 __all__ = ["STATUS_FIELDS", "StiffnessQpSystem"]
 
 
@@ -86,10 +91,11 @@ class StiffnessQpSystem(LeafSystem):
         self._zeta = float(qp.damping_ratio)
         self._dt = float(params.period_s)
         self._constant = constant_stiffness(params.reference)
-        self._solver = (
+        self._min_energy = float(params.tank.min_energy_J)
+        self._solve = (
             None
             if self._constant is not None
-            else StiffnessQp(qp.solver, osqp_eps=qp.osqp_eps)
+            else StiffnessQp(qp.solver, osqp_eps=qp.osqp_eps).solve
         )
         ports = {}
         for name, size in (
@@ -100,7 +106,13 @@ class StiffnessQpSystem(LeafSystem):
             ("tank_energy", 1),
         ):
             ports[name] = self.DeclareVectorInputPort(name, size)
-        self._in = ports
+        (
+            self._in_position,
+            self._in_velocity,
+            self._in_target,
+            self._in_references,
+            self._in_energy,
+        ) = ports.values()
         k0 = self._constant if self._constant is not None else self._k_min
         d0 = [2.0 * self._zeta * math.sqrt(k) for k in k0]
         status0 = np.zeros(len(STATUS_FIELDS))
@@ -110,6 +122,9 @@ class StiffnessQpSystem(LeafSystem):
         tick0 = np.zeros(QP_TICK_SIZE)  # No tick yet: not active.
         tick0[QP_TICK_STIFFNESS] = k0
         tick0[QP_TICK_DAMPING_USED] = d0
+        # Every tick's qp_tick starts from this list (active: 1 for VS, 0 for CS/CF).
+        self._tick_template = [0.0] * QP_TICK_SIZE
+        self._tick_template[QP_TICK_ACTIVE] = 0.0 if self._constant is not None else 1.0
         for name, value in (
             ("stiffness", k0),
             ("damping", d0),
@@ -118,74 +133,79 @@ class StiffnessQpSystem(LeafSystem):
         ):
             self._index[name] = self.DeclareDiscreteState(np.asarray(value, float))
             self._out[name] = self.DeclareStateOutputPort(name, self._index[name])
+        self._state_groups = tuple(
+            self._index[name] for name in ("stiffness", "damping", "qp_tick", "status")
+        )
         self.DeclarePeriodicDiscreteUpdateEvent(self._dt, 0.0, self._update)
 
     def _update(self, context, discrete_state):
-        inp, index = self._in, self._index
-        p_WP = inp["probe.position"].Eval(context).tolist()
-        v_WP = inp["probe.velocity"].Eval(context).tolist()
-        x_d = inp["target_position"].Eval(context).tolist()
-        refs = inp["references"].Eval(context).tolist()
-        energy = float(inp["tank_energy"].Eval(context)[0])
-        k_prev = context.get_discrete_state(index["stiffness"]).value().tolist()
-        count = context.get_discrete_state(index["status"]).GetAtIndex(
-            STATUS_FALLBACK_COUNT
-        )
-        f_ref, f_min = refs[REF_FORCE_REFERENCE], refs[REF_FORCE_MIN]
-        zeta = self._zeta
+        # On entry discrete_state holds the current state (a LeafSystem copies
+        # it in before calling an update handler): K is read there, and the
+        # fallback count is incremented in place.
+        p_WP = self._in_position.Eval(context).tolist()
+        v_WP = self._in_velocity.Eval(context).tolist()
+        x_d = self._in_target.Eval(context).tolist()
+        refs = self._in_references.Eval(context).tolist()
+        energy = self._in_energy.Eval(context).tolist()[0]
+        i_k, i_d, i_tick, i_status = self._state_groups
+        k_prev = discrete_state.value(i_k).tolist()
+        zeta2 = 2.0 * self._zeta
         d_used = (
-            2.0 * zeta * math.sqrt(max(k_prev[0], 0.0)),
-            2.0 * zeta * math.sqrt(max(k_prev[1], 0.0)),
-            2.0 * zeta * math.sqrt(max(k_prev[2], 0.0)),
+            zeta2 * math.sqrt(max(k_prev[0], 0.0)),
+            zeta2 * math.sqrt(max(k_prev[1], 0.0)),
+            zeta2 * math.sqrt(max(k_prev[2], 0.0)),
         )
         # A sum of floats is finite iff every term is (inf - inf = nan).
         total = sum(p_WP) + sum(v_WP) + sum(x_d) + sum(refs) + energy
         fault = not math.isfinite(total) or refs[REF_FAULT] > 0.5
-        e = (0.0, 0.0, 0.0)
-        e_dot = (0.0, 0.0, 0.0)
-        qp_ok, solve_time = 1.0, 0.0
-        active = 0.0 if self._constant is not None else 1.0
+        e = e_dot = (0.0, 0.0, 0.0)
+        ok, solve_time = True, 0.0
         if fault:
             k = self._k_min
-            qp_ok = 0.0
-            count += 1.0
+            ok = False
         elif self._constant is not None:
             k = self._constant
         else:
             e = (x_d[0] - p_WP[0], x_d[1] - p_WP[1], x_d[2] - p_WP[2])
             e_dot = (-v_WP[0], -v_WP[1], -v_WP[2])
-            if energy < self._params.tank.min_energy_J:
+            if energy < self._min_energy:
                 k = self._k_min
             else:
                 problem = make_stiffness_qp_problem(
-                    e, e_dot, d_used, f_ref, f_min, energy, self._dt,
-                    self._params.qp, self._params.tank,
+                    e, e_dot, d_used, refs[REF_FORCE_REFERENCE], refs[REF_FORCE_MIN],
+                    energy, self._dt, self._params.qp, self._params.tank,
                 )  # fmt: skip
-                sol = self._solver.solve(problem, guess=k_prev)  # Warm start (OSQP).
+                # The solvers that take an initial guess start from the last K.
+                sol = self._solve(problem, guess=k_prev)
                 k = sol.stiffness
                 solve_time = sol.solve_time_s
-                if not sol.success:
-                    qp_ok = 0.0
-                    count += 1.0
-        tick = [0.0] * QP_TICK_SIZE
+                ok = sol.success
+        # Written through numpy views of discrete_state: an element store costs
+        # far less than converting a Python sequence in set_value.
+        k0, k1, k2 = k
+        out = discrete_state.get_mutable_value(i_k)
+        out[0], out[1], out[2] = k0, k1, k2
+        out = discrete_state.get_mutable_value(i_d)
+        out[0] = zeta2 * math.sqrt(max(k0, 0.0))
+        out[1] = zeta2 * math.sqrt(max(k1, 0.0))
+        out[2] = zeta2 * math.sqrt(max(k2, 0.0))
+        tick = self._tick_template.copy()
         tick[QP_TICK_POSITION_ERROR] = e
         tick[QP_TICK_VELOCITY_ERROR] = e_dot
         tick[QP_TICK_STIFFNESS] = k
         tick[QP_TICK_DAMPING_USED] = d_used
-        tick[QP_TICK_ACTIVE] = active
-        in_contact = 0.0 if fault else refs[REF_IN_CONTACT]
-        pen = refs[REF_PENETRATION] if math.isfinite(refs[REF_PENETRATION]) else 0.0
-        for name, value in (
-            ("stiffness", k),
-            ("damping", [2.0 * zeta * math.sqrt(max(k_i, 0.0)) for k_i in k]),
-            ("qp_tick", tick),
-            # In the order of STATUS_FIELDS.
-            (
-                "status",
-                [qp_ok, count, 1.0 if fault else 0.0, in_contact, solve_time, pen],
-            ),
-        ):
-            discrete_state.set_value(index[name], value)
+        discrete_state.get_mutable_value(i_tick)[:] = tick
+        status = discrete_state.get_mutable_value(i_status)
+        if ok:
+            status[STATUS_QP_OK] = 1.0
+        else:
+            status[STATUS_QP_OK] = 0.0
+            status[STATUS_FALLBACK_COUNT] += 1.0
+        status[_STATUS_FAULT] = 1.0 if fault else 0.0
+        status[_STATUS_IN_CONTACT] = 0.0 if fault else refs[REF_IN_CONTACT]
+        status[_STATUS_SOLVE_TIME] = solve_time
+        pen = refs[REF_PENETRATION]
+        status[_STATUS_PENETRATION] = pen if math.isfinite(pen) else 0.0
 
     def get_stiffness_output_port(self):
         return self._out["stiffness"]

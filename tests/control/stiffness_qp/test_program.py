@@ -5,12 +5,13 @@ import pytest
 from hypothesis import given, settings
 
 from tests.control.stiffness_qp.cases import problem, random_problems
+from vic_drake.control.params import StiffnessQpParams
 from vic_drake.control.stiffness_qp.exact import solve_stiffness_qp_exact
 from vic_drake.control.stiffness_qp.problem import (
     stiffness_qp_cost,
     stiffness_qp_violation,
 )
-from vic_drake.control.stiffness_qp.program import StiffnessQp
+from vic_drake.control.stiffness_qp.program import PROGRAM_SOLVERS, StiffnessQp
 
 
 def test_program_is_built_once(osqp):
@@ -40,7 +41,7 @@ def test_mathematical_program_matches_exact_oracle(osqp, p):
     assert viol["bounds_N_per_m"] <= 1e-6 and viol["force_N"] <= 1e-6
     assert viol["tank_energy_W"] <= 1e-6 and viol["tank_power_W"] <= 1e-6
     assert np.allclose(mp.stiffness, exact.stiffness, atol=1e-6, rtol=0)
-    # Warm-started from a far point, OSQP lands on the same optimum.
+    # A far guess (which Drake's OSQP ignores) does not move the optimum.
     warm = osqp.solve(p, guess=p.stiffness_max)
     assert warm.success and np.allclose(
         warm.stiffness, exact.stiffness, atol=1e-6, rtol=0
@@ -65,5 +66,26 @@ def test_clarabel_matches_exact_oracle(clarabel, p):
 def test_unknown_solver_is_a_clear_error():
     from vic_drake.errors import VicDrakeError
 
-    with pytest.raises(VicDrakeError, match="'osqp', 'clarabel' or 'exact'"):
+    with pytest.raises(
+        VicDrakeError, match="'exact' or a Drake solver \\('osqp', 'clarabel'"
+    ):
         StiffnessQp("gurobi")
+
+
+@pytest.mark.parametrize("solver", PROGRAM_SOLVERS)
+def test_every_drake_solver_runs_the_program(solver):
+    # The solvers measured by benchmarks/bench_controller.py, on an interior
+    # optimum (moving errors) and a K_max-capped one (flat x, y at K_min).
+    # Clarabel and IPOPT (interior point) approach the flat bounds only to
+    # ~0.04 and ~4e-4 N/m; the others land within 1e-6 N/m.
+    qp = StiffnessQp(solver)
+    tol = {"clarabel": 0.05, "ipopt": 1e-3}.get(solver, 1e-6)
+    for p in (
+        problem((0.004, -0.003, -0.02), (0.01, -0.02, 0.03)),
+        problem((0.0, 0.0, -0.005), qp=StiffnessQpParams(r_weight=[1e-5] * 3)),
+    ):
+        sol = qp.solve(p, guess=(500.0, 500.0, 500.0))
+        assert sol.success and sol.status == "optimal"
+        assert np.allclose(
+            sol.stiffness, solve_stiffness_qp_exact(p).stiffness, atol=tol, rtol=0
+        )

@@ -6,14 +6,14 @@ strictly convex quadratic on a box with one linear inequality. Its KKT
 conditions give k(mu) = clip(k_free + mu a / (2 (Q e^2 + R)), lo, hi), and
 a' k(mu) is piecewise linear and nondecreasing in the multiplier mu >= 0;
 the exact optimum is found by walking the <= 6 breakpoints. Plain floats, no
-numpy: it runs every tick. The test oracle of the MathematicalProgram
-(:mod:`vic_drake.control.stiffness_qp.program`) and the default fast path.
+numpy, the three axes unrolled: it runs every tick. The test oracle of the
+MathematicalProgram (:mod:`vic_drake.control.stiffness_qp.program`) and the
+default fast path.
 """
 
 from __future__ import annotations
 
-import math
-import time
+from time import perf_counter
 
 from vic_drake.control.stiffness_qp.constraints import (
     ACTIVE_TANK_ENERGY,
@@ -24,6 +24,8 @@ from vic_drake.control.stiffness_qp.problem import (
     StiffnessQpSolution,
     fallback_solution,
 )
+
+_INF = float("inf")
 
 
 def solve_stiffness_qp_exact(
@@ -40,100 +42,76 @@ def solve_stiffness_qp_exact(
         The unique optimum, or K_min with success=False and status
         "infeasible" when the constraints cannot all hold.
     """
-    t0 = time.perf_counter()
+    t0 = perf_counter()
     (e, ed, d, fr, fmn, fmx, kmn, kmx, qw, rw, a, lb_energy, lb_power) = problem
-    lo = []
-    hi = []
-    lo_bit = []
-    hi_bit = []
-    free = []
-    curv = []  # 2 (Q e^2 + R): d^2 cost / dk^2.
-    bit = 1
-    # Per axis: the bound and force rows make one interval [lo, hi]; the
-    # unconstrained minimiser is `free`.
-    for ei, edi, di, fri, fmin, fmax, kmin, kmax, q, r in zip(
-        e, ed, d, fr, fmn, fmx, kmn, kmx, qw, rw
-    ):
-        dv = di * edi
-        lo_i, hi_i = kmin, kmax
-        lb_i, hb_i = bit, bit << 1
-        fmin_i, fmax_i = fmin - dv, fmax - dv
-        if ei > 0.0:
-            f_lo, f_hi = fmin_i / ei, fmax_i / ei
-            if f_lo > lo_i:
-                lo_i, lb_i = f_lo, bit << 2
-            if f_hi < hi_i:
-                hi_i, hb_i = f_hi, bit << 3
-        elif ei < 0.0:
-            f_lo, f_hi = fmax_i / ei, fmin_i / ei
-            if f_lo > lo_i:
-                lo_i, lb_i = f_lo, bit << 3
-            if f_hi < hi_i:
-                hi_i, hb_i = f_hi, bit << 2
-        elif fmin_i > feas_tol * max(1.0, abs(fmin)) or fmax_i < -feas_tol * max(
-            1.0, abs(fmax)
-        ):
-            return fallback_solution(problem, t0, "infeasible")
-        if lo_i > hi_i:
-            if lo_i - hi_i > feas_tol * max(1.0, abs(hi_i)):
-                return fallback_solution(problem, t0, "infeasible")
-            hi_i = lo_i
-        lo.append(lo_i)
-        hi.append(hi_i)
-        lo_bit.append(lb_i)
-        hi_bit.append(hb_i)
-        h = q * ei * ei + r
-        curv.append(2.0 * h)
-        free.append((q * ei * (fri - dv) + r * kmin) / h)
-        bit <<= 4
+    x0 = _axis(e[0], ed[0], d[0], fr[0], fmn[0], fmx[0], kmn[0], kmx[0], qw[0], rw[0],
+               1, feas_tol)  # fmt: skip
+    x1 = _axis(e[1], ed[1], d[1], fr[1], fmn[1], fmx[1], kmn[1], kmx[1], qw[1], rw[1],
+               1 << 4, feas_tol)  # fmt: skip
+    x2 = _axis(e[2], ed[2], d[2], fr[2], fmn[2], fmx[2], kmn[2], kmx[2], qw[2], rw[2],
+               1 << 8, feas_tol)  # fmt: skip
+    if x0 is None or x1 is None or x2 is None:
+        return fallback_solution(problem, t0, "infeasible")
+    lo0, hi0, lob0, hib0, f0, c0 = x0
+    lo1, hi1, lob1, hib1, f1, c1 = x1
+    lo2, hi2, lob2, hib2, f2, c2 = x2
+    a0, a1, a2 = a
 
     # mu = 0: clip the free minimiser to the box.
-    k = [
-        lo_i if v < lo_i else (hi_i if v > hi_i else v)
-        for v, lo_i, hi_i in zip(free, lo, hi)
-    ]
-    g = a[0] * k[0] + a[1] * k[1] + a[2] * k[2]
+    k0 = lo0 if f0 < lo0 else (hi0 if f0 > hi0 else f0)
+    k1 = lo1 if f1 < lo1 else (hi1 if f1 > hi1 else f1)
+    k2 = lo2 if f2 < lo2 else (hi2 if f2 > hi2 else f2)
+    g = a0 * k0 + a1 * k1 + a2 * k2
     lb = lb_energy if lb_energy > lb_power else lb_power
     mu = 0.0
     if g < lb:
         # The tank row is active. k(mu) = clip(free + mu a / curv, lo, hi) and
         # a' k(mu) is piecewise linear and nondecreasing: walk its breakpoints.
-        def at(mu_: float) -> tuple[list[float], float]:
-            k_ = [0.0, 0.0, 0.0]
-            g_ = 0.0
-            for i in range(3):
-                v = free[i] + mu_ * a[i] / curv[i]
-                k_[i] = lo[i] if v < lo[i] else (hi[i] if v > hi[i] else v)
-                g_ += a[i] * k_[i]
-            return k_, g_
+        def at(m: float) -> tuple[float, float, float, float]:
+            v0 = f0 + m * a0 / c0
+            v1 = f1 + m * a1 / c1
+            v2 = f2 + m * a2 / c2
+            v0 = lo0 if v0 < lo0 else (hi0 if v0 > hi0 else v0)
+            v1 = lo1 if v1 < lo1 else (hi1 if v1 > hi1 else v1)
+            v2 = lo2 if v2 < lo2 else (hi2 if v2 > hi2 else v2)
+            return v0, v1, v2, 0.0 + a0 * v0 + a1 * v1 + a2 * v2
 
-        best = 0.0
-        scale = 0.0
-        for i in range(3):
-            best += a[i] * (hi[i] if a[i] > 0.0 else lo[i])
-            scale += abs(a[i]) * max(abs(hi[i]), 1.0)
+        best = (
+            0.0
+            + a0 * (hi0 if a0 > 0.0 else lo0)
+            + a1 * (hi1 if a1 > 0.0 else lo1)
+            + a2 * (hi2 if a2 > 0.0 else lo2)
+        )
+        scale = (
+            0.0
+            + abs(a0) * max(abs(hi0), 1.0)
+            + abs(a1) * max(abs(hi1), 1.0)
+            + abs(a2) * max(abs(hi2), 1.0)
+        )
         if best < lb - feas_tol * max(scale, abs(lb), 1e-12):
             return fallback_solution(problem, t0, "infeasible")
         if best <= lb:
-            mu = math.inf
-            k = [
-                hi[i] if a[i] > 0.0 else (lo[i] if a[i] < 0.0 else k[i])
-                for i in range(3)
-            ]
+            mu = _INF
+            k0 = hi0 if a0 > 0.0 else (lo0 if a0 < 0.0 else k0)
+            k1 = hi1 if a1 > 0.0 else (lo1 if a1 < 0.0 else k1)
+            k2 = hi2 if a2 > 0.0 else (lo2 if a2 < 0.0 else k2)
         else:
             breaks = []
-            for i in range(3):
-                if a[i] != 0.0:
-                    s = curv[i] / a[i]
-                    for bound in (lo[i], hi[i]):
-                        m = (bound - free[i]) * s
-                        if m > 0.0:
-                            breaks.append(m)
+            for ai, ci, fi, loi, hii in ((a0, c0, f0, lo0, hi0), (a1, c1, f1, lo1, hi1),
+                                         (a2, c2, f2, lo2, hi2)):  # fmt: skip
+                if ai != 0.0:
+                    s = ci / ai
+                    m = (loi - fi) * s
+                    if m > 0.0:
+                        breaks.append(m)
+                    m = (hii - fi) * s
+                    if m > 0.0:
+                        breaks.append(m)
             breaks.sort()
             m_prev, g_prev = 0.0, g
             m_hit = g_hit = None
             for m in breaks:
-                _, g_m = at(m)
+                g_m = at(m)[3]
                 if g_m >= lb:
                     m_hit, g_hit = m, g_m
                     break
@@ -142,16 +120,61 @@ def solve_stiffness_qp_exact(
                 mu = m_prev
             else:
                 mu = m_prev + (lb - g_prev) * (m_hit - m_prev) / (g_hit - g_prev)
-            k, g = at(mu)
+            k0, k1, k2, g = at(mu)
     active = 0
-    for i in range(3):
-        if k[i] <= lo[i]:
-            active |= lo_bit[i]
-        if k[i] >= hi[i]:
-            active |= hi_bit[i]
+    if k0 <= lo0:
+        active |= lob0
+    if k0 >= hi0:
+        active |= hib0
+    if k1 <= lo1:
+        active |= lob1
+    if k1 >= hi1:
+        active |= hib1
+    if k2 <= lo2:
+        active |= lob2
+    if k2 >= hi2:
+        active |= hib2
     if mu > 0.0:
-        active |= ACTIVE_TANK_ENERGY if lb_energy >= lb_power else 0
-        active |= ACTIVE_TANK_POWER if lb_power >= lb_energy else 0
+        if lb_energy >= lb_power:
+            active |= ACTIVE_TANK_ENERGY
+        if lb_power >= lb_energy:
+            active |= ACTIVE_TANK_POWER
     return StiffnessQpSolution(
-        (k[0], k[1], k[2]), True, active, time.perf_counter() - t0, "optimal"
+        (k0, k1, k2), True, active, perf_counter() - t0, "optimal"
     )
+
+
+def _axis(ei, edi, di, fri, fmin, fmax, kmin, kmax, q, r, bit, feas_tol):
+    """One axis of the QP: (lo, hi, lo_bit, hi_bit, free, curv), or None if infeasible.
+
+    The bound and force rows make one interval [lo, hi]; lo_bit and hi_bit
+    are the mask bits of the rows that set its ends (bit: the axis' K_min
+    bit). free is the axis' unconstrained minimiser and curv = 2 (Q e^2 + R)
+    the cost's curvature d^2 cost / dk^2.
+    """
+    dv = di * edi
+    lo, hi = kmin, kmax
+    lo_bit, hi_bit = bit, bit << 1
+    fmin_i, fmax_i = fmin - dv, fmax - dv
+    if ei > 0.0:
+        f_lo, f_hi = fmin_i / ei, fmax_i / ei
+        if f_lo > lo:
+            lo, lo_bit = f_lo, bit << 2
+        if f_hi < hi:
+            hi, hi_bit = f_hi, bit << 3
+    elif ei < 0.0:
+        f_lo, f_hi = fmax_i / ei, fmin_i / ei
+        if f_lo > lo:
+            lo, lo_bit = f_lo, bit << 3
+        if f_hi < hi:
+            hi, hi_bit = f_hi, bit << 2
+    elif fmin_i > feas_tol * max(1.0, abs(fmin)) or fmax_i < -feas_tol * max(
+        1.0, abs(fmax)
+    ):
+        return None
+    if lo > hi:
+        if lo - hi > feas_tol * max(1.0, abs(hi)):
+            return None
+        hi = lo
+    h = q * ei * ei + r
+    return lo, hi, lo_bit, hi_bit, (q * ei * (fri - dv) + r * kmin) / h, 2.0 * h
