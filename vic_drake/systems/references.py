@@ -63,7 +63,7 @@ _ESTIMATE_SURFACE_Z = ESTIMATE_FIELDS.index("surface_z_m")
 
 
 def _array(values: list) -> np.ndarray:
-    """The floats of a list as an array (np.fromiter: cheaper than np.array)."""
+    """The floats of a list as a float array."""
     return np.fromiter(values, float, len(values))
 
 
