@@ -47,10 +47,9 @@ class PointLookup:
         self._xs = [float(v) for v in xs]
         self._ys = [float(v) for v in ys]
         self._grids = [np.asarray(g, float).tolist() for g in grids]
-        # Rows i and i + 1 of every grid, by i: the bilinear lookup's cells.
-        self._row_pairs = [
-            [(g[i], g[i + 1]) for g in self._grids] for i in range(len(self._xs) - 1)
-        ]
+        # The five values at each node, interleaved: one tuple per corner.
+        self._nodes = [list(zip(*(g[i] for g in self._grids), strict=True))
+                       for i in range(len(self._xs))]  # fmt: skip
         self.bounds = (self._xs[0], self._xs[-1], self._ys[0], self._ys[-1])
 
     def __call__(self, x, y) -> tuple[float, float, float, float, float]:
@@ -73,11 +72,16 @@ class PointLookup:
         else:
             w00, w10 = (1 - wx) * (1 - wy), wx * (1 - wy)
             w01, w11 = (1 - wx) * wy, wx * wy
-            j1 = j + 1
-            z, gx, gy, kappa, lam = [
-                w00 * g0[j] + w10 * g1[j] + w01 * g0[j1] + w11 * g1[j1]
-                for g0, g1 in self._row_pairs[i]
-            ]
+            row0, row1 = self._nodes[i], self._nodes[i + 1]
+            z00, gx00, gy00, k00, l00 = row0[j]
+            z10, gx10, gy10, k10, l10 = row1[j]
+            z01, gx01, gy01, k01, l01 = row0[j + 1]
+            z11, gx11, gy11, k11, l11 = row1[j + 1]
+            z = w00 * z00 + w10 * z10 + w01 * z01 + w11 * z11
+            gx = w00 * gx00 + w10 * gx10 + w01 * gx01 + w11 * gx11
+            gy = w00 * gy00 + w10 * gy10 + w01 * gy01 + w11 * gy11
+            kappa = w00 * k00 + w10 * k10 + w01 * k01 + w11 * k11
+            lam = w00 * l00 + w10 * l10 + w01 * l01 + w11 * l11
         return z, (gx if in_x else 0.0), (gy if in_y else 0.0), kappa, lam
 
     def sample(self, x, y) -> TissueSample:
