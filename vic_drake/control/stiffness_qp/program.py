@@ -102,8 +102,8 @@ class StiffnessQp:
     a' diag(s) / |a' diag(s)|. Each :meth:`solve` makes two calls into
     Drake before the solve (``UpdateCoefficients`` of the cost and of the
     rows) and reuses one ``MathematicalProgramResult``. A row that holds
-    over the whole box K_min <= k <= K_max gets the bounds (-inf, inf): it
-    cannot be active, and interior-point Clarabel fails on near-zero rows
+    over the whole box K_min <= k <= K_max gets the bounds (-inf, inf)
+    (+-1e20 for NLopt): it cannot be active, and interior-point Clarabel fails on near-zero rows
     such as 1e-12 k >= c that a vanishing error produces.
 
     Scaling. For every solver but Clarabel, s_i = 1 / sqrt(2 (Q_i e_i^2 +
@@ -113,7 +113,8 @@ class StiffnessQp:
     Clarabel (interior point, its own equilibration) is run with k in kN/m
     (s_i = 1e3) and the cost normalised by its largest curvature. Accuracy
     and cost of each solver against the exact solver: see docs/decisions.md,
-    "Stiffness QP solvers and scaling".
+    "Stiffness QP solvers and scaling" and "Stiffness QP solvers of the Drake
+    1.51 wheel: cost and accuracy".
 
     Args:
         solver: one of :data:`PROGRAM_SOLVERS`, or "exact" (which skips the
