@@ -57,7 +57,9 @@ class StiffnessQpSystem(LeafSystem):
         references (13): ForceReferenceSystem's "references" (F_ref, F_min,
             target force, contact; layout in :mod:`vic_drake.systems.signals`).
         tank_energy (1): T before this tick, J (EnergyTankSystem's
-            "tank_energy").
+            "tank_energy"; in MakeVariableImpedanceController the same
+            number, element TANK_ENERGY of its "tank" record, through a
+            C++ Demultiplexer).
 
     Output ports (the last tick, from state):
         stiffness (3): K, N/m.
