@@ -218,7 +218,7 @@ class TissueForceElement(LeafSystem):
         self._contact_cache = self.DeclareCacheEntry(
             description="tip_contact",
             value_producer=ValueProducer(
-                allocate=AbstractValue.Make(None).Clone, calc=self._calc_contact
+                allocate=AbstractValue.Make(()).Clone, calc=self._calc_contact
             ),
             prerequisites_of_calc=prerequisites,
         )

@@ -77,9 +77,10 @@ def test_every_drake_solver_runs_the_program(solver):
     # The solvers measured by benchmarks/bench_controller.py, on an interior
     # optimum (moving errors) and a K_max-capped one (flat x, y at K_min).
     # Clarabel and IPOPT (interior point) approach the flat bounds only to
-    # ~0.04 and ~4e-4 N/m; the others land within 1e-6 N/m.
+    # ~0.04 and ~4e-4 N/m; SCS (first order) to 3e-6 N/m with drake 1.58's
+    # SCS (its survey error reached 2e-4 N/m); the others land within 1e-6 N/m.
     qp = StiffnessQp(solver)
-    tol = {"clarabel": 0.05, "ipopt": 1e-3}.get(solver, 1e-6)
+    tol = {"clarabel": 0.05, "ipopt": 1e-3, "scs": 1e-4}.get(solver, 1e-6)
     for p in (
         problem((0.004, -0.003, -0.02), (0.01, -0.02, 0.03)),
         problem((0.0, 0.0, -0.005), qp=StiffnessQpParams(r_weight=[1e-5] * 3)),
