@@ -33,13 +33,12 @@ import json
 import os
 import pstats
 import statistics
-import subprocess
 import sys
 import time
 from collections import defaultdict
 from dataclasses import replace
 
-from common import versions
+from common import HERE, is_checkout, run_in_checkout, versions
 
 
 def plant_ceiling_rtf(scenario, duration_s: float) -> tuple[float, float]:
@@ -120,17 +119,13 @@ def _run_tree(tree: str, args) -> dict:
         value = getattr(args, option)
         if value is not None:
             command += [f"--{option.replace('_', '-')}", str(value)]
-    env = dict(os.environ, PYTHONPATH=os.path.abspath(tree))
-    done = subprocess.run(command, env=env, capture_output=True, text=True)
-    if done.returncode != 0:
-        sys.exit(f"bench_scan: the run of {tree} failed:\n{done.stderr[-2000:]}")
+    done = run_in_checkout(tree, command)
     return json.loads(done.stdout.strip().splitlines()[-1])
 
 
 def _compare(args) -> None:
     """The scan of this checkout and of ``--baseline``, alternated, in fresh processes."""
-    here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    trees = {"baseline": args.baseline, "current": here}
+    trees = {"baseline": args.baseline, "current": HERE}
     runs = {name: [] for name in trees}
     for _ in range(args.repeat):  # Alternated: the host is shared and noisy.
         for name, tree in trees.items():
@@ -190,9 +185,7 @@ def main() -> None:
         parser.error(f"--repeat must be >= 1; got {args.repeat}")
     if not args.duration > 0:
         parser.error(f"--duration must be > 0; got {args.duration}")
-    if args.baseline is not None and not os.path.isdir(
-        os.path.join(args.baseline, "vic_drake")
-    ):
+    if args.baseline is not None and not is_checkout(args.baseline):
         parser.error(f"--baseline must be a checkout of vic_drake; got {args.baseline}")
     if args.worker:
         _worker(args)

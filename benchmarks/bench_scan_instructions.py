@@ -23,7 +23,7 @@ import subprocess
 import sys
 import tempfile
 
-from common import versions
+from common import HERE, is_checkout, run_in_checkout, versions
 
 
 def _worker(controller: str, t0: float, t1: float) -> None:
@@ -62,11 +62,10 @@ def _count(tree: str, args) -> float:
         command += [f"--callgrind-out-file={out}", sys.executable]
         command += [os.path.abspath(__file__), "--worker", args.controller]
         command += ["--from", str(args.t0), "--to", str(args.t1)]
-        env = dict(os.environ, PYTHONPATH=os.path.abspath(tree))
-        done = subprocess.run(command, env=env, capture_output=True, text=True)
+        done = run_in_checkout(tree, command)
         ticks = re.search(r"^ticks (\d+)", done.stdout, re.M)
         dumps = [p for p in glob.glob(out + ".*") if not p.endswith(out)]
-        if done.returncode != 0 or ticks is None or not dumps:
+        if ticks is None or not dumps:
             sys.exit(f"the run of {tree} failed:\n{done.stderr[-2000:]}")
         with open(sorted(dumps)[0]) as f:
             summary = re.search(r"^summary: (\d+)", f.read(), re.M)
@@ -88,14 +87,11 @@ def main() -> int:
         return 0
     if shutil.which("valgrind") is None:
         parser.error("valgrind is not installed (Debian: apt-get install valgrind)")
-    if args.baseline is not None and not os.path.isdir(
-        os.path.join(args.baseline, "vic_drake")
-    ):
+    if args.baseline is not None and not is_checkout(args.baseline):
         parser.error(f"--baseline must be a checkout of vic_drake; got {args.baseline}")
     print(versions())
     print(f"{args.controller} scan, ticks from {args.t0} s to {args.t1} s (in contact)")
-    here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    trees = {"current": here}
+    trees = {"current": HERE}
     if args.baseline is not None:
         trees = {"baseline": args.baseline, **trees}
     counts = {name: _count(tree, args) for name, tree in trees.items()}

@@ -15,12 +15,11 @@ from __future__ import annotations
 
 import argparse
 import os
-import subprocess
 import sys
 import tempfile
 
 import pandas as pd
-from common import versions
+from common import HERE, is_checkout, run_in_checkout, versions
 
 #: (controller, disturbed) of the compared scans.
 CASES = (
@@ -45,12 +44,7 @@ def _worker(out_dir: str, duration_s: float) -> None:
 def _run(tree: str, out_dir: str, duration_s: float) -> None:
     command = [sys.executable, os.path.abspath(__file__), "--worker", out_dir]
     command += ["--duration", str(duration_s)]
-    env = dict(os.environ, PYTHONPATH=os.path.abspath(tree))
-    done = subprocess.run(command, env=env, capture_output=True, text=True)
-    if done.returncode != 0:
-        sys.exit(
-            f"compare_scan_logs: the scans of {tree} failed:\n{done.stderr[-2000:]}"
-        )
+    run_in_checkout(tree, command)
 
 
 def main() -> int:
@@ -64,16 +58,13 @@ def main() -> int:
     if args.worker:
         _worker(args.worker, args.duration)
         return 0
-    if args.baseline is None or not os.path.isdir(
-        os.path.join(args.baseline, "vic_drake")
-    ):
+    if not is_checkout(args.baseline):
         parser.error(f"--baseline must be a checkout of vic_drake; got {args.baseline}")
     print(versions())
-    here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     worst = 0.0
     with tempfile.TemporaryDirectory() as old, tempfile.TemporaryDirectory() as new:
         _run(args.baseline, old, args.duration)
-        _run(here, new, args.duration)
+        _run(HERE, new, args.duration)
         for controller, disturbed in CASES:
             name = f"{controller}_{int(disturbed)}.parquet"
             a = pd.read_parquet(os.path.join(old, name))

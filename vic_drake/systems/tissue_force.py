@@ -308,7 +308,12 @@ class TissueForceElement(LeafSystem):
         """sum_i g_i s_i of the branch states in ``context``, m^beta."""
         if self._branches is None:
             return 0.0
-        s = context.get_discrete_state(self._branches).value().tolist()
+        return self._weighted(
+            context.get_discrete_state(self._branches).value().tolist()
+        )
+
+    def _weighted(self, s) -> float:
+        """sum_i g_i s_i of branch states ``s``, m^beta."""
         return sum(g * s_i for g, s_i in zip(self._g, s, strict=True))
 
     def _calc_contact(self, context, value):
@@ -342,12 +347,9 @@ class TissueForceElement(LeafSystem):
              p_WT, v_WT, p_WPh, v_WPh)
         )  # fmt: skip
 
-    def _store(self, context, discrete_state, relaxed: float, tick: float) -> None:
-        """Stores the sample of the cached kinematics at ``relaxed``, for ``tick``."""
-        _, _, _, _, sample, p_WT, v_WT, p_WPh, v_WPh = self._contact_cache.Eval(context)
-        terms = contact_terms(
-            sample, self._beta, p_WT, v_WT, p_WPh, v_WPh, *self._settings, relaxed
-        )
+    def _store(self, context, discrete_state, terms, tick: float) -> None:
+        """Stores the sample of the cached kinematics with ``terms``, for ``tick``."""
+        _, _, _, _, _, p_WT, v_WT, p_WPh, _ = self._contact_cache.Eval(context)
         force, eps, eps_dot, surface, kappa, lam = terms[:6]
         discrete_state.set_value(
             self._sample,
@@ -362,21 +364,27 @@ class TissueForceElement(LeafSystem):
         return float(round(context.get_time() / self._period))
 
     def _initialize(self, context, discrete_state):
-        self._store(
-            context, discrete_state, self._relaxed(context), self._tick(context)
-        )
+        # The cached terms are those of this context's branch states.
+        terms = self._contact_cache.Eval(context)[3]
+        self._store(context, discrete_state, terms, self._tick(context))
 
     def _update(self, context, discrete_state):
-        relaxed = 0.0
+        cached = self._contact_cache.Eval(context)
+        terms = cached[3]
         if self._branches is not None:
-            eps = self._contact_cache.Eval(context)[3][1]
+            eps = terms[1]
             u = (eps if eps > 0.0 else 0.0) ** self._beta  # relaxation_input
             s = context.get_discrete_state(self._branches).value().tolist()
             # relaxation_step: u + (s - u) exp(-dt / tau), per branch.
             s = [u + (s_i - u) * d for s_i, d in zip(s, self._decay, strict=True)]
             discrete_state.set_value(self._branches, np.array(s))
-            relaxed = sum(g * s_i for g, s_i in zip(self._g, s, strict=True))
-        self._store(context, discrete_state, relaxed, self._tick(context) + 1.0)
+            # The same kinematics and map sample, with the branches after the tick.
+            sample, p_WT, v_WT, p_WPh, v_WPh = cached[4:]
+            terms = contact_terms(
+                sample, self._beta, p_WT, v_WT, p_WPh, v_WPh, *self._settings,
+                self._weighted(s),
+            )  # fmt: skip
+        self._store(context, discrete_state, terms, self._tick(context) + 1.0)
 
     def _calc_spatial_forces(self, context, output):
         tick = context.get_discrete_state(self._sample_tick).value()[0]
