@@ -54,6 +54,26 @@ variations:
         (lambda: MapErrorConfig(kappa_scale=0.0), "kappa_scale"),
         (lambda: MapErrorConfig(surface_offset_m=0.5), "surface_offset_m"),
         (lambda: PatientConfig(curvature_scale=-1.0), "curvature_scale"),
+        (
+            lambda: BreathingConfig(lateral_amplitude_m=[0.02, 0.0]),
+            r"lateral_amplitude_m\[0\] must be within \[-0.01, 0.01\] m",
+        ),
+        (
+            lambda: BreathingConfig(lateral_amplitude_m=[0.0, -0.011]),
+            r"lateral_amplitude_m\[1\] must be within",
+        ),
+        (
+            lambda: BreathingConfig(lateral_amplitude_m=[0.0, float("nan")]),
+            r"lateral_amplitude_m\[1\] must be finite",
+        ),
+        (
+            lambda: BreathingConfig(lateral_amplitude_m=[0.001]),
+            r"lateral_amplitude_m must be 2 numbers \[x, y\]",
+        ),
+        (
+            lambda: BreathingConfig(lateral_amplitude_m=[0.001, "left"]),
+            r"lateral_amplitude_m\[1\] must be a number",
+        ),
     ],
 )
 def test_bad_values_name_the_field(make, message):
@@ -61,9 +81,26 @@ def test_bad_values_name_the_field(make, message):
         make()
 
 
+def test_lateral_breathing_is_off_by_default_and_on_alone():
+    assert not BreathingConfig().lateral_active
+    lateral = BreathingConfig(lateral_amplitude_m=[0.0, -0.003])
+    assert lateral.lateral_active and lateral.active  # Even with amplitude_m 0.
+    s = loads_scenario(
+        "variations: {motion: {breathing: "
+        "{amplitude_m: 0.01, lateral_amplitude_m: [0.004, -0.002]}}}"
+    )
+    assert s.variations.motion.lateral_active
+    assert s.variations.motion.breathing.lateral_amplitude_m == [0.004, -0.002]
+    assert loads_scenario(dumps_scenario(s, only_changes=True)) == s
+
+
 def test_bad_values_in_yaml_are_caught_at_load():
     with pytest.raises(VicDrakeError, match="amplitude_m"):
         loads_scenario("variations: {motion: {breathing: {amplitude_m: 0.5}}}")
+    with pytest.raises(VicDrakeError, match=r"lateral_amplitude_m\[0\]"):
+        loads_scenario(
+            "variations: {motion: {breathing: {lateral_amplitude_m: [0.05, 0]}}}"
+        )
     with pytest.raises(VicDrakeError, match="synthetic"):
         loads_scenario(
             "phantom: {kind: measured}\nvariations: {patient: {enabled: true}}"

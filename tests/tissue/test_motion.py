@@ -6,6 +6,7 @@ import pytest
 from vic_drake.errors import VicDrakeError
 from vic_drake.tissue.motion import (
     breath_cycles,
+    breathing_lateral_m,
     breathing_offset_m,
     load_motion_trace,
     trace_offset_m,
@@ -42,6 +43,29 @@ def test_irregular_breathing_varies_each_breath_and_stays_continuous():
         frequency_hz=0.3, amplitude_m=0.01, irregularity=0.3, duration_s=60, seed=4
     )
     np.testing.assert_array_equal(again.period_s, c.period_s)
+
+
+def test_lateral_part_follows_each_breath_in_phase_scaled_as_its_depth():
+    c = breath_cycles(
+        frequency_hz=0.3, amplitude_m=0.01, irregularity=0.3, duration_s=30, seed=2
+    )
+    t = np.arange(0, 30, 0.01)
+    z = _offsets(c, t)
+    xy = np.array([breathing_lateral_m(x, c, (0.004, -0.002)) for x in t])
+    # In phase with the breath, and each breath's excursion is the lateral
+    # amplitude times that breath's depth relative to the mean (z / 0.01 m).
+    np.testing.assert_allclose(xy[:, 0], 0.004 * z / 0.01, atol=1e-15)
+    np.testing.assert_allclose(xy[:, 1], -0.002 * z / 0.01, atol=1e-15)
+    np.testing.assert_allclose(c.depth_scale * 0.01, c.amplitude_m)
+    assert np.std(c.depth_scale) > 0.05  # Irregular: the breaths differ.
+    assert breathing_lateral_m(0.0, c, (0.004, -0.002)) == (0.0, 0.0)
+    # Regular breathing: the raised cosine of the given lateral excursion.
+    r = breath_cycles(
+        frequency_hz=0.25, amplitude_m=0.0, irregularity=0.0, duration_s=10, seed=0
+    )
+    x = np.array([breathing_lateral_m(v, r, (0.003, 0.0))[0] for v in t[:1000]])
+    expected = 0.003 * 0.5 * (1 - np.cos(2 * np.pi * 0.25 * t[:1000]))
+    np.testing.assert_allclose(x, expected, atol=1e-15)
 
 
 def test_motion_trace_reads_interpolates_and_rejects_bad_files(tmp_path):

@@ -28,7 +28,7 @@ from pydrake.systems.primitives import (
 
 from vic_drake.errors import VicDrakeError
 from vic_drake.experiments.rig_log import add_rig_loggers
-from vic_drake.experiments.scan_logs import LOG_GROUPS
+from vic_drake.experiments.scan_logs import LATERAL_LOG_GROUP, LOG_GROUPS
 from vic_drake.experiments.scan_variations import (
     add_sensor_faults,
     controller_map,
@@ -136,7 +136,8 @@ def MakeScanDiagram(scenario: Scenario, *, phantom=None, meshcat=None, data_dir=
 
     Returns:
         (diagram, loggers): the Diagram named "scan" and a dict
-        {group name: VectorLogSink} of :data:`LOG_GROUPS` and of
+        {group name: VectorLogSink} of :data:`LOG_GROUPS` (and
+        :data:`LATERAL_LOG_GROUP` when the phantom moves laterally) and of
         :data:`vic_drake.experiments.rig_log.RIG_GROUPS`.
     """
     if not isinstance(scenario, Scenario):
@@ -147,9 +148,18 @@ def MakeScanDiagram(scenario: Scenario, *, phantom=None, meshcat=None, data_dir=
         phantom = load_scenario_phantom(scenario, data_dir=data_dir)
     q0 = initial_joint_positions(scenario)
     builder = DiagramBuilder()
+    # Lateral joints under the phantom only when the scenario moves it
+    # sideways: every other scenario builds the 7-position plant.
+    lateral = scenario.variations.motion.lateral_active
     station = builder.AddNamedSystem(
         "station",
-        MakeStation(scenario.station, phantom=phantom, meshcat=meshcat, initial_q=q0),
+        MakeStation(
+            scenario.station,
+            phantom=phantom,
+            meshcat=meshcat,
+            initial_q=q0,
+            phantom_lateral=lateral,
+        ),
     )
     controller = builder.AddNamedSystem(
         "variable_impedance_controller",
@@ -221,13 +231,21 @@ def MakeScanDiagram(scenario: Scenario, *, phantom=None, meshcat=None, data_dir=
         fdcc.GetOutputPort("position_command"),
         station.GetInputPort("ur3e.position_command"),
     )
-    builder.Connect(lift.get_output_port(), station.GetInputPort("phantom.lift"))
+    # Port 0: the lift (a PatientMotionSource's second port is the lateral one).
+    builder.Connect(lift.get_output_port(0), station.GetInputPort("phantom.lift"))
+    groups = LOG_GROUPS
+    if lateral:
+        builder.Connect(
+            motion.get_phantom_lateral_output_port(),
+            station.GetInputPort("phantom.lateral"),
+        )
+        groups = (*LOG_GROUPS, LATERAL_LOG_GROUP)
 
     sources = {
         system.get_name(): system for system in (station, controller, fdcc, target)
     }
     loggers = {}
-    for group in LOG_GROUPS:
+    for group in groups:
         port = sources[group.source].GetOutputPort(group.port)
         if port.size() != len(group.fields):
             raise VicDrakeError(

@@ -145,16 +145,33 @@ LOG_GROUPS = (
 )
 
 
+#: Logged only when the phantom moves laterally (a lateral breathing part):
+#: its x, y offset, as columns after the canonical ones.
+LATERAL_LOG_GROUP = LogGroup(
+    "phantom_lateral",
+    "station",
+    "phantom.lateral_offset",
+    ("x", "y"),
+    {"x": "phantom_x_m", "y": "phantom_y_m"},
+)
+#: The columns :data:`LATERAL_LOG_GROUP` adds.
+LATERAL_COLUMNS = ("phantom_x_m", "phantom_y_m")
+
+
 def logs_to_frame(loggers: dict, root_context) -> pd.DataFrame:
     """The loggers' records as one DataFrame of the canonical columns.
 
     Args:
-        loggers: {group name: VectorLogSink} of :data:`LOG_GROUPS`.
+        loggers: {group name: VectorLogSink} of :data:`LOG_GROUPS` (and of
+            :data:`LATERAL_LOG_GROUP`, whose :data:`LATERAL_COLUMNS` then
+            follow the canonical ones).
         root_context: the scan diagram's root context after the simulation.
     """
+    lateral = LATERAL_LOG_GROUP.name in loggers
+    groups = (*LOG_GROUPS, LATERAL_LOG_GROUP) if lateral else LOG_GROUPS
     data = {}
     t = None
-    for group in LOG_GROUPS:
+    for group in groups:
         log = loggers[group.name].FindLog(root_context)
         if t is None:
             t = log.sample_times().copy()
@@ -164,7 +181,15 @@ def logs_to_frame(loggers: dict, root_context) -> pd.DataFrame:
             data[column] = values[i, :n]
     n = min(len(v) for v in data.values())
     df = pd.DataFrame({"t_s": t[:n], **{k: v[:n] for k, v in data.items()}})
-    return df[list(CANONICAL_COLUMNS)]
+    return df[list(CANONICAL_COLUMNS) + (list(LATERAL_COLUMNS) if lateral else [])]
 
 
-__all__ = ["JOINTS", "LOG_GROUPS", "XYZ", "LogGroup", "logs_to_frame"]
+__all__ = [
+    "JOINTS",
+    "LATERAL_COLUMNS",
+    "LATERAL_LOG_GROUP",
+    "LOG_GROUPS",
+    "XYZ",
+    "LogGroup",
+    "logs_to_frame",
+]

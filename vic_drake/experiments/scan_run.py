@@ -32,7 +32,8 @@ class ScanResult:
     """A simulated scan.
 
     Attributes:
-        df: canonical scan DataFrame (see vic_drake.analysis.columns.CANONICAL_COLUMNS).
+        df: canonical scan DataFrame (see vic_drake.analysis.columns.CANONICAL_COLUMNS;
+            with a lateral breathing part, then ``phantom_x_m``, ``phantom_y_m``).
         scenario: the exact scenario that ran.
         wall_s: wall-clock time of the simulation (excluding building), s.
         sim_s: simulated time, s.

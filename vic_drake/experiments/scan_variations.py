@@ -36,7 +36,10 @@ def controller_map(scenario: Scenario, phantom):
 
 
 def patient_motion_source(scenario: Scenario):
-    """A PatientMotionSource (lifts + breathing + trace), or None without motion."""
+    """A PatientMotionSource (lifts + breathing + trace), or None without motion.
+
+    With a lateral breathing part it has the ``phantom_lateral`` output too.
+    """
     motion = scenario.variations.motion
     if not motion.active:
         return None
@@ -58,6 +61,7 @@ def patient_motion_source(scenario: Scenario):
         breaths=breaths,
         trace=trace,
         trace_scale=motion.trace_scale,
+        lateral_amplitude_m=b.lateral_amplitude_m if b.lateral_active else None,
     )
 
 

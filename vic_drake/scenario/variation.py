@@ -5,8 +5,9 @@ is off by default, so a scenario without it runs the paper's scan unchanged:
 
 - ``patient``: a synthetic patient's chest
   (:mod:`vic_drake.tissue.phantom.population`, ranges documented there);
-- ``motion``: breathing and a replayed motion trace, added to the
-  scenario's phantom lifts (:mod:`vic_drake.tissue.motion`);
+- ``motion``: breathing (optionally with a small lateral part) and a
+  replayed motion trace, added to the scenario's phantom lifts
+  (:mod:`vic_drake.tissue.motion`);
 - ``sensor_faults``: faults of the force reading the controllers see
   (:mod:`vic_drake.control.sensor_faults`); the station's own sensor and the
   logs keep the true reading;
@@ -76,17 +77,29 @@ class PatientConfig:
         return self
 
 
+#: Largest |lateral excursion| of a breath per axis, m: a small lateral part.
+LATERAL_BREATHING_MAX_M = 0.01
+
+
 @dataclass
 class BreathingConfig:
-    """Breathing: a periodic surface motion along the chest's normal (W z).
+    """Breathing: a periodic surface motion along the chest's normal (W z),
+    optionally with a small lateral part (W x, y).
 
-    Typical adult breathing: 0.2-0.33 Hz, 5-15 mm. ``amplitude_m`` = 0 is off.
+    Typical adult breathing: 0.2-0.33 Hz, 5-15 mm. ``amplitude_m`` = 0 and
+    ``lateral_amplitude_m`` = [0, 0] is off. A lateral part moves the
+    phantom in x and y with the breath (same raised cosine, in phase, each
+    breath's excursion scaled as its depth); the station then has lateral
+    joints under the phantom (only then).
     """
 
     frequency_hz: float = 0.25  # Mean breathing rate, Hz.
     amplitude_m: float = 0.0  # Mean peak-to-peak surface excursion, m (0: off).
     irregularity: float = 0.0  # Relative std of each breath's period and depth.
     seed: int = 0  # Seed of the irregular breaths.
+    # Peak-to-peak excursion of a mean breath along W x and y, m, signed
+    # (|each| <= 0.01 m; [0, 0]: vertical breathing only).
+    lateral_amplitude_m: list[float] = field(default_factory=lambda: [0.0, 0.0])
 
     def __post_init__(self):
         self.validate()
@@ -97,11 +110,29 @@ class BreathingConfig:
         check_number(o, "amplitude_m", self.amplitude_m, low=0.0, high=0.04)
         check_number(o, "irregularity", self.irregularity, low=0.0, high=0.5)
         _check_int(o, "seed", self.seed, 0)
+        lateral = self.lateral_amplitude_m
+        if not isinstance(lateral, (list, tuple)) or len(lateral) != 2:
+            raise VicDrakeError(
+                f"{o}.lateral_amplitude_m must be 2 numbers [x, y] (m); got {lateral!r}"
+            )
+        m = LATERAL_BREATHING_MAX_M
+        for i, value in enumerate(lateral):
+            name = f"lateral_amplitude_m[{i}]"
+            if abs(check_number(o, name, value)) > m:
+                raise VicDrakeError(
+                    f"{o}.{name} must be within [-{m}, {m}] m (a small lateral "
+                    f"part of the breath); got {value!r}"
+                )
         return self
 
     @property
+    def lateral_active(self) -> bool:
+        """The breath moves the phantom in x or y too."""
+        return any(v != 0 for v in self.lateral_amplitude_m)
+
+    @property
     def active(self) -> bool:
-        return self.amplitude_m > 0
+        return self.amplitude_m > 0 or self.lateral_active
 
 
 @dataclass
@@ -135,6 +166,11 @@ class PatientMotionConfig:
     @property
     def active(self) -> bool:
         return self.breathing.active or bool(self.trace_csv)
+
+    @property
+    def lateral_active(self) -> bool:
+        """The phantom moves in x or y (the station needs its lateral joints)."""
+        return self.breathing.lateral_active
 
 
 @dataclass
@@ -267,6 +303,7 @@ class VariationConfig:
 
 
 __all__ = [
+    "LATERAL_BREATHING_MAX_M",
     "BreathingConfig",
     "MapErrorConfig",
     "PatientConfig",

@@ -1,9 +1,9 @@
 """MakeStation: the simulated rig as a Diagram (UR3e, F/T sensor, indenter, phantom).
 
 The arm and tool are :mod:`vic_drake.models.ur3e`; the phantom (body Ph) is
-the chest on a prismatic z joint (``phantom_lift``) at ``phantom_offset_m``;
-its frame carries the map's coordinates, so with zero lift and offset the
-map is in W.
+the chest on a prismatic z joint (``phantom_lift``) at ``phantom_offset_m``
+(with ``phantom_lateral=True``, on x and y joints too); its frame carries
+the map's coordinates, so with zero lift and offset the map is in W.
 
 Forces: the tissue's push on the indenter is the Hunt-Crossley element of
 :mod:`vic_drake.systems.tissue_force` (Drake contact between the indenter
@@ -34,7 +34,7 @@ from pydrake.common import RandomDistribution
 from pydrake.math import RigidTransform
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import Diagram, DiagramBuilder
-from pydrake.systems.primitives import Demultiplexer, RandomSource
+from pydrake.systems.primitives import Demultiplexer, MatrixGain, RandomSource
 
 from vic_drake.errors import VicDrakeError
 from vic_drake.station.params import StationParams
@@ -51,6 +51,7 @@ def MakeStation(
     phantom: Phantom,
     meshcat=None,
     initial_q=None,
+    phantom_lateral: bool = False,
 ) -> Diagram:
     """Builds the simulated rig as a Diagram named ``"station"``.
 
@@ -61,10 +62,15 @@ def MakeStation(
         meshcat: optional Meshcat for visualization.
         initial_q: optional default joint angles (6,), rad (e.g. from
             :func:`initial_q_for_tip`); default all zero.
+        phantom_lateral: the phantom also moves in x and y (two more servoed
+            prismatic joints, and the ``phantom.lateral`` ports); False:
+            the lift only.
 
     Input ports:
         ur3e.position_command (6): commanded joint angles, rad.
         phantom.lift (1): phantom z offset command, m (servoed stiffly).
+        phantom.lateral (2): phantom x, y offset command, m (servoed as the
+            lift; only with ``phantom_lateral``).
     Output ports:
         ur3e.state (12): q (rad), v (rad/s).
         ft_sensor.force_W (3): tared, noisy (and, with sensor_lag_samples,
@@ -80,6 +86,8 @@ def MakeStation(
             stored by the tissue element (its ``SAMPLE_FIELDS``; what the
             scan logs).
         phantom.z_offset (1): the phantom's current lift, m.
+        phantom.lateral_offset (2): its current x, y offset, m (only with
+            ``phantom_lateral``).
         plant.body_poses, plant.contact_results: for logging/visualization.
     """
     if not isinstance(params, StationParams):
@@ -91,11 +99,15 @@ def MakeStation(
             f"phantom must be a vic_drake.tissue.Phantom, got {type(phantom).__name__}"
         )
     builder = DiagramBuilder()
-    rig = AddRig(builder, params, phantom, initial_q=initial_q)
+    rig = AddRig(
+        builder, params, phantom, initial_q=initial_q, phantom_lateral=phantom_lateral
+    )
     plant, ur3e, arm = rig.plant, rig.ur3e, rig.arm
     phantom_model, phantom_body = rig.phantom_model, rig.phantom_body
     builder.ExportInput(rig.position_command, "ur3e.position_command")
     builder.ExportInput(rig.phantom_lift, "phantom.lift")
+    if rig.phantom_lateral is not None:
+        builder.ExportInput(rig.phantom_lateral, "phantom.lateral")
 
     # Hunt-Crossley tissue force on the tip (relaxing unless tissue_law="hc").
     p_IP = np.array([0.0, 0.0, params.indenter_length_m])
@@ -175,9 +187,14 @@ def MakeStation(
     builder.ExportOutput(tissue.get_tip_velocity_output_port(), "probe.velocity")
 
     builder.ExportOutput(plant.get_state_output_port(ur3e), "ur3e.state")
-    demux = builder.AddNamedSystem("phantom_state_demux", Demultiplexer(2, 1))
-    builder.Connect(plant.get_state_output_port(phantom_model), demux.get_input_port())
-    builder.ExportOutput(demux.get_output_port(0), "phantom.z_offset")
+    if rig.phantom_lateral is None:
+        demux = builder.AddNamedSystem("phantom_state_demux", Demultiplexer(2, 1))
+        builder.Connect(
+            plant.get_state_output_port(phantom_model), demux.get_input_port()
+        )
+        builder.ExportOutput(demux.get_output_port(0), "phantom.z_offset")
+    else:
+        _export_phantom_offsets(builder, plant, phantom_model)
     builder.ExportOutput(plant.get_body_poses_output_port(), "plant.body_poses")
     builder.ExportOutput(
         plant.get_contact_results_output_port(), "plant.contact_results"
@@ -194,6 +211,30 @@ def MakeStation(
     return diagram
 
 
+def _export_phantom_offsets(builder, plant, phantom_model) -> None:
+    """Exports the lift and the x, y joints' positions of a laterally moving phantom."""
+    # The model's state is [q; v] in the plant's order of its positions.
+    q_of_model = list(
+        plant.GetPositionsFromArray(
+            phantom_model, np.arange(plant.num_positions(), dtype=float)
+        )
+    )
+    n = 2 * len(q_of_model)
+    for names, port in (
+        (("phantom_lift",), "phantom.z_offset"),
+        (("phantom_x", "phantom_y"), "phantom.lateral_offset"),
+    ):
+        select = np.zeros((len(names), n))
+        for row, name in enumerate(names):
+            start = plant.GetJointByName(name, phantom_model).position_start()
+            select[row, q_of_model.index(float(start))] = 1.0
+        gain = builder.AddNamedSystem(f"{port}_select", MatrixGain(select))
+        builder.Connect(
+            plant.get_state_output_port(phantom_model), gain.get_input_port()
+        )
+        builder.ExportOutput(gain.get_output_port(), port)
+
+
 def station_plant(station: Diagram) -> MultibodyPlant:
     """The station's MultibodyPlant (subsystem "plant")."""
     return station.GetSubsystemByName("plant")
@@ -202,7 +243,10 @@ def station_plant(station: Diagram) -> MultibodyPlant:
 def set_station_state(
     station: Diagram, station_context, q, *, phantom_lift_m: float = 0.0
 ):
-    """Sets the arm at rest at q (6,) and the phantom at a lift, in a station context."""
+    """Sets the arm at rest at q (6,) and the phantom at a lift, in a station context.
+
+    The phantom is at rest, at zero lateral offset if it has lateral joints.
+    """
     plant = station_plant(station)
     plant_context = station.GetMutableSubsystemContext(plant, station_context)
     ur3e = plant.GetModelInstanceByName("ur3e")
@@ -213,8 +257,12 @@ def set_station_state(
         joint_servo_rest_state(q)
     )
     phantom = plant.GetModelInstanceByName("phantom")
-    plant.SetPositions(plant_context, phantom, [phantom_lift_m])
-    plant.SetVelocities(plant_context, phantom, [0.0])
+    n = plant.num_positions(phantom)  # 1, or 3 with the lateral joints
+    plant.SetPositions(plant_context, phantom, np.zeros(n))
+    plant.SetVelocities(plant_context, phantom, np.zeros(n))
+    plant.GetJointByName("phantom_lift", phantom).set_translation(
+        plant_context, phantom_lift_m
+    )
 
 
 __all__ = ["MakeStation", "set_station_state", "station_plant"]

@@ -7,6 +7,11 @@ servo, the phantom's lift servo and the gravity feed-forward.
 :func:`vic_drake.station.MakeStation` adds the Python tissue force element
 and F/T sensor on top; ``benchmarks/bench_scan.py`` simulates the rig alone
 as the speed ceiling of a scan.
+
+With ``phantom_lateral=True`` the phantom rides on two carriages, on
+prismatic joints along W x (``phantom_x``) and y (``phantom_y``), under its
+lift, each servoed with the lift's gains; without it the plant is the
+7-position plant of every other scenario.
 """
 
 from typing import NamedTuple
@@ -62,6 +67,8 @@ class Rig(NamedTuple):
         phantom_model, phantom_body: the phantom's model instance and body.
         position_command: input port (6) of the commanded joint angles, rad.
         phantom_lift: input port (1) of the phantom's lift command, m.
+        phantom_lateral: input port (2) of the phantom's x, y command, m
+            (None without lateral joints).
     """
 
     plant: object
@@ -72,9 +79,44 @@ class Rig(NamedTuple):
     phantom_body: object
     position_command: object
     phantom_lift: object
+    phantom_lateral: object = None
 
 
-def _add_phantom(plant, params: StationParams, phantom: Phantom):
+#: Mass of each lateral carriage under the phantom, kg (a fictitious stage:
+#: small beside the phantom, but a body on a joint needs mass).
+CARRIAGE_MASS_KG = 0.05
+
+
+def _add_servo(plant, joint, params: StationParams) -> None:
+    """A PD actuator with the phantom lift's gains on a prismatic joint."""
+    actuator = plant.AddJointActuator(f"{joint.name()}_actuator", joint)
+    actuator.set_controller_gains(
+        PdControllerGains(p=params.phantom_kp_N_per_m, d=params.phantom_kd_Ns_per_m)
+    )
+
+
+def _add_carriages(plant, model, base_frame):
+    """The lateral stage: an x carriage on ``base_frame``, a y carriage on it.
+
+    Returns the y carriage's frame (the lift's parent) and the two joints.
+    """
+    inertia = SpatialInertia(
+        CARRIAGE_MASS_KG, np.zeros(3), UnitInertia.SolidSphere(0.01)
+    )
+    joints = []
+    parent = base_frame
+    for axis, name in (([1, 0, 0], "x"), ([0, 1, 0], "y")):
+        carriage = plant.AddRigidBody(f"phantom_carriage_{name}", model, inertia)
+        joints.append(
+            plant.AddJoint(
+                PrismaticJoint(f"phantom_{name}", parent, carriage.body_frame(), axis)
+            )
+        )
+        parent = carriage.body_frame()
+    return parent, joints
+
+
+def _add_phantom(plant, params: StationParams, phantom: Phantom, lateral: bool):
     model = plant.AddModelInstance("phantom")
     x_min, x_max, y_min, y_max = phantom.bounds
     size = np.array([x_max - x_min, y_max - y_min, params.phantom_thickness_m])
@@ -92,13 +134,15 @@ def _add_phantom(plant, params: StationParams, phantom: Phantom):
             "phantom_base", plant.world_frame(), RigidTransform(params.phantom_offset_m)
         )
     )
+    lift_parent, lateral_joints = frame_on_world, []
+    if lateral:
+        lift_parent, lateral_joints = _add_carriages(plant, model, frame_on_world)
     joint = plant.AddJoint(
-        PrismaticJoint("phantom_lift", frame_on_world, body.body_frame(), [0, 0, 1])
+        PrismaticJoint("phantom_lift", lift_parent, body.body_frame(), [0, 0, 1])
     )
-    actuator = plant.AddJointActuator("phantom_lift_actuator", joint)
-    actuator.set_controller_gains(
-        PdControllerGains(p=params.phantom_kp_N_per_m, d=params.phantom_kd_Ns_per_m)
-    )
+    # Actuators [lift, x, y]: the order of the phantom's servo commands.
+    for servoed in (joint, *lateral_joints):
+        _add_servo(plant, servoed, params)
     vtk, obj = phantom_mesh_paths(
         phantom,
         resolution_m=params.phantom_mesh_resolution_m,
@@ -145,7 +189,14 @@ def _make_links_hydroelastic(plant, scene_graph, ur3e, params):
     return ids
 
 
-def AddRig(builder, params: StationParams, phantom: Phantom, *, initial_q=None) -> Rig:
+def AddRig(
+    builder,
+    params: StationParams,
+    phantom: Phantom,
+    *,
+    initial_q=None,
+    phantom_lateral: bool = False,
+) -> Rig:
     """Adds the rig's C++ systems to ``builder`` (see the module docstring).
 
     Args:
@@ -153,17 +204,25 @@ def AddRig(builder, params: StationParams, phantom: Phantom, *, initial_q=None) 
         params: the rig (validated here).
         phantom: the tissue map (its surface gives the contact mesh).
         initial_q: optional default joint angles (6,), rad.
+        phantom_lateral: give the phantom x and y joints (lateral motion);
+            False: the lift only.
 
     Returns:
-        :class:`Rig`; its two input ports are left for the caller to connect
+        :class:`Rig`; its input ports are left for the caller to connect
         or export.
     """
     params.validate()
+    if not isinstance(phantom_lateral, bool):
+        raise VicDrakeError(
+            f"phantom_lateral must be true or false; got {phantom_lateral!r}"
+        )
     plant, scene_graph = AddMultibodyPlant(params.plant, builder)
     plant.mutable_gravity_field().set_gravity_vector([0, 0, -params.gravity_m_per_s2])
     ur3e = AddUr3e(plant)
     arm = AddTool(plant, ur3e, params)
-    phantom_model, phantom_body, phantom_geometry = _add_phantom(plant, params, phantom)
+    phantom_model, phantom_body, phantom_geometry = _add_phantom(
+        plant, params, phantom, phantom_lateral
+    )
     link_geometries = _make_links_hydroelastic(plant, scene_graph, ur3e, params)
     tool_geometries = list(arm.tool_geometries.values())
     indenter_geometries = [
@@ -223,13 +282,22 @@ def AddRig(builder, params: StationParams, phantom: Phantom, *, initial_q=None) 
     builder.Connect(
         ur_filter.get_output_port(), plant.get_desired_state_input_port(ur3e)
     )
+    # The phantom's servo: its commands [lift(, x, y)] in actuator order.
+    n_phantom = plant.num_actuators(phantom_model)
     lift_interp = builder.AddNamedSystem(
         "phantom_lift_interpolator",
-        StateInterpolatorWithDiscreteDerivative(1, params.command_period_s, True),
+        StateInterpolatorWithDiscreteDerivative(
+            n_phantom, params.command_period_s, True
+        ),
     )
     builder.Connect(
         lift_interp.get_output_port(), plant.get_desired_state_input_port(phantom_model)
     )
+    lift_port, lateral_port = lift_interp.get_input_port(), None
+    if phantom_lateral:
+        commands = builder.AddNamedSystem("phantom_command_mux", Multiplexer([1, 2]))
+        builder.Connect(commands.get_output_port(), lift_interp.get_input_port())
+        lift_port, lateral_port = commands.get_input_port(0), commands.get_input_port(1)
 
     # Gravity feed-forward (the UR controller's own gravity compensation, and
     # the phantom's weight held by its lift).
@@ -243,7 +311,7 @@ def AddRig(builder, params: StationParams, phantom: Phantom, *, initial_q=None) 
         plant.get_state_output_port(), gravity.get_input_port_estimated_state()
     )
     nv = plant.num_velocities()
-    for model, n in ((ur3e, 6), (phantom_model, 1)):
+    for model, n in ((ur3e, 6), (phantom_model, n_phantom)):
         select = np.zeros((n, nv))
         for row, a in enumerate(plant.GetJointActuatorIndices(model)):
             select[row, plant.get_joint_actuator(a).joint().velocity_start()] = 1.0
@@ -263,7 +331,8 @@ def AddRig(builder, params: StationParams, phantom: Phantom, *, initial_q=None) 
         phantom_model,
         phantom_body,
         servo_inputs.get_input_port(0),
-        lift_interp.get_input_port(),
+        lift_port,
+        lateral_port,
     )
 
 

@@ -56,6 +56,44 @@ def test_grid_cycles_and_draws_depend_only_on_seed_and_index(tmp_path):
     assert len({p.factors["variations.map_errors.kappa_scale"] for p in plans}) == 8
 
 
+def test_a_factor_sets_one_axis_of_the_lateral_breathing(tmp_path):
+    path = _spec(
+        tmp_path,
+        "factors:\n"
+        "  - {field: variations.motion.breathing.amplitude_m, dist: grid,"
+        " values: [0.005, 0.01]}\n"
+        "  - {field: 'variations.motion.breathing.lateral_amplitude_m[0]',"
+        " dist: uniform, low: -0.004, high: 0.004}\n",
+    )
+    _, plans = _plans(path)
+    lateral = [
+        p.scenario().variations.motion.breathing.lateral_amplitude_m for p in plans
+    ]
+    drawn = [
+        p.factors["variations.motion.breathing.lateral_amplitude_m[0]"] for p in plans
+    ]
+    assert [x for x, _ in lateral] == pytest.approx(drawn)
+    assert all(y == 0.0 for _, y in lateral)  # The other axis stays the base's.
+    assert len(set(drawn)) == len(plans) and all(abs(x) <= 0.004 for x in drawn)
+    assert all(p.scenario().variations.motion.lateral_active for p in plans)
+    # Beyond the allowed range: the run's check names the item.
+    bad = _spec(
+        tmp_path,
+        "factors:\n  - {field: 'variations.motion.breathing.lateral_amplitude_m[1]',"
+        " dist: uniform, low: 0.02, high: 0.03}\n",
+    )
+    with pytest.raises(VicDrakeError, match=r"lateral_amplitude_m\[1\] must be within"):
+        _plans(bad)
+    with pytest.raises(VicDrakeError, match="has no item 2"):
+        _plans(
+            _spec(
+                tmp_path,
+                "factors:\n  - {field: 'variations.motion.breathing.lateral_amplitude_m[2]',"
+                " dist: uniform, low: 0, high: 0.001}\n",
+            )
+        )
+
+
 def test_population_draws_a_patient_per_run(tmp_path):
     _, plans = _plans(_spec(tmp_path, "population: true\n"))
     s = plans[0].scenario()
