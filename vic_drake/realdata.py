@@ -177,6 +177,14 @@ def read_bag(path: str | os.PathLike, *, expect: str | None = None) -> pd.DataFr
     return df
 
 
+#: How far the real phantom's surface lay above the published map's tissue
+#: surface (z + PhantomMapData.surface_offset_m) in the scans, m: the rig's
+#: default for a log that holds no evidence of its own. The mean first-contact
+#: offset of the two 31-column logs
+#: (vic_drake.experiments.surface_calibration.rig_surface_offset).
+RIG_SURFACE_OFFSET_M = 0.00375
+
+
 @dataclass(frozen=True)
 class PhantomMapData:
     """The measured GP map as the real controller loaded it.

@@ -18,6 +18,16 @@ def test_compare_real_rejects_bad_numbers(tmp_path, capsys):
     assert "--force" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("value", ["rig", "25", "nan", ""])
+def test_compare_real_rejects_a_bad_surface_offset_before_reading_the_bag(
+    tmp_path, capsys, value
+):
+    assert main(["compare-real", str(tmp_path), "--surface-offset", value]) == 2
+    err = capsys.readouterr().err
+    assert "--surface-offset takes none or auto or a number of mm" in err
+    assert "Traceback" not in err
+
+
 @pytest.mark.realdata
 def test_compare_real_rejects_palpation_bag(data_dir, capsys):
     assert main(["compare-real", str(data_dir / "palpation" / "test_soft_1hz")]) == 2

@@ -17,6 +17,10 @@ MOTION_KEYS = (
     "contact_loss_total_sim_s",
     "contact_loss_total_real_s",
     "contact_loss_overlap_s",
+    "surface_offset_mm",
+    "surface_offset_source",
+    "surface_first_contact_mm",
+    "controller_map_offset_mm",
 )
 
 
@@ -60,6 +64,10 @@ def test_compare_real_reports_the_motion_and_contact_loss(
     moved = sim["phantom_lift_m"].abs().max()
     assert bool(moved > 1e-4) is replayed
     assert ("lift_max_mm" in out) is replayed
+    # No surface offset by default; a 9-column log holds no evidence of one.
+    assert out["surface_offset_mm"] == 0.0 and out["surface_offset_source"] == "none"
+    assert out["surface_first_contact_mm"] is None
+    assert out["controller_map_offset_mm"] is None
 
 
 @pytest.mark.realdata

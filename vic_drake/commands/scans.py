@@ -35,6 +35,27 @@ def _positive(value: str, option: str) -> float:
     return v
 
 
+def _surface_offset(value: str):
+    """--surface-offset: "auto", "none" or a number of mm (returned in m)."""
+    from vic_drake.experiments.surface_calibration import (
+        MAX_SURFACE_OFFSET_M,
+        SURFACE_OFFSET_MODES,
+    )
+
+    if value in SURFACE_OFFSET_MODES:
+        return value
+    try:
+        v = float(value)
+    except ValueError:
+        v = math.nan
+    if not (math.isfinite(v) and abs(v) <= 1e3 * MAX_SURFACE_OFFSET_M):
+        raise VicDrakeError(
+            f"--surface-offset takes {' or '.join(SURFACE_OFFSET_MODES)} or a number "
+            f"of mm within +-{1e3 * MAX_SURFACE_OFFSET_M:g}; got {value!r}"
+        )
+    return v * 1e-3
+
+
 def register(subparsers) -> None:
     p = subparsers.add_parser(
         "compare-real",
@@ -96,6 +117,15 @@ def register(subparsers) -> None:
         "or plain Hunt-Crossley",
     )
     p.add_argument(
+        "--surface-offset",
+        metavar="MM|auto|none",
+        default=None,
+        help="raise the simulated tissue above the published map: a number of mm, "
+        "'auto' (the log's first contact when it approaches from free space, else "
+        "the rig's default) or 'none' (the default); the controller keeps reading "
+        "the published map",
+    )
+    p.add_argument(
         "--plot", metavar="PNG", default=None, help="save a sim-vs-real figure"
     )
     p.add_argument(
@@ -154,6 +184,9 @@ def run_compare_real(args: argparse.Namespace) -> int:
     force = None if args.force is None else _positive(args.force, "--force")
     r = None if args.r_weight is None else _positive(args.r_weight, "--R")
     duration = None if args.duration is None else _positive(args.duration, "--duration")
+    offset = (
+        None if args.surface_offset is None else _surface_offset(args.surface_offset)
+    )
     # Output paths are checked before simulating: a bad one fails now.
     if args.out:
         check_output_file(args.out, "--out", LOG_SUFFIXES)
@@ -169,6 +202,7 @@ def run_compare_real(args: argparse.Namespace) -> int:
         data_dir=args.data_dir,
         duration_s=duration,
         tissue_law=args.tissue_law,
+        surface_offset=offset,
         progress=progress,
         return_frames=True,
     )

@@ -31,10 +31,15 @@ from vic_drake.experiments.real_logs import (
     scenario_from_real_log,
 )
 from vic_drake.experiments.scan_run import run_scan
+from vic_drake.experiments.surface_calibration import (
+    parse_surface_offset,
+    surface_calibration,
+)
 from vic_drake.realdata import read_bag
 from vic_drake.scenario import DisturbanceConfig
 from vic_drake.tissue import TISSUE_LAWS
 from vic_drake.tissue.phantom import load_phantom
+from vic_drake.tissue.phantom.distorted import with_map_errors
 
 
 def phantom_replay(bag: Path, real, phantom):
@@ -75,6 +80,7 @@ def compare_real(
     data_dir=None,
     duration_s: float | None = None,
     tissue_law: str | None = None,
+    surface_offset: float | str | None = None,
     progress=None,
     return_frames: bool = False,
 ):
@@ -90,6 +96,11 @@ def compare_real(
     :func:`vic_drake.analysis.phantom_motion.map_surface_error_m`);
     contact losses of both runs are compared.
     Alignment: :func:`vic_drake.analysis.real_comparison.compare_with_real`.
+    ``surface_offset`` raises the simulated tissue above the published map:
+    a number of m, "auto" or "none", None for
+    :data:`~vic_drake.experiments.surface_calibration.DEFAULT_SURFACE_OFFSET`
+    (:func:`~vic_drake.experiments.surface_calibration.surface_calibration`);
+    the controller keeps reading the published map.
 
     Returns:
         dict with the contract keys controller, duration_s, force_rmse_N,
@@ -102,7 +113,10 @@ def compare_real(
         ``controller_identified`` holds what was identified from the log
         (:func:`~vic_drake.experiments.real_logs.identify_real_log`) and
         ``tissue_law`` the simulated tissue's law ("relaxing" unless
-        ``tissue_law`` says "hc").
+        ``tissue_law`` says "hc"). ``surface_offset_mm`` is the offset
+        applied, ``surface_offset_source`` where it came from; the log's
+        evidence: ``surface_first_contact_mm`` (and its ``_sigma_mm``) and
+        ``controller_map_offset_mm`` (None when the log holds none).
         With ``return_frames``: (dict, sim DataFrame, real canonical DataFrame).
     """
     bag = Path(bag_dir)
@@ -121,6 +135,7 @@ def compare_real(
         raise VicDrakeError(
             f"tissue_law must be one of {list(TISSUE_LAWS)}; got {tissue_law!r}"
         )
+    surface_offset = parse_surface_offset(surface_offset)
     # The controller first: a log whose signals cannot tell fails before the
     # motion estimate and the simulation.
     identification = identify_real_log(
@@ -131,7 +146,10 @@ def compare_real(
         r_weight=r_weight,
     )
     real = real_to_canonical(raw)
-    phantom = load_phantom("measured", data_dir=data_dir, lookup="bilinear")
+    published = load_phantom("measured", data_dir=data_dir, lookup="bilinear")
+    surface = surface_calibration(real, published, surface_offset)
+    # The simulated tissue: the published map raised by the offset.
+    phantom = with_map_errors(published, surface_offset_m=surface["offset_m"])
     motion, table, surface_error = phantom_replay(bag, real, phantom)
     replay = bool(table)
     disturbance = DisturbanceConfig(table=table) if replay else None
@@ -164,6 +182,10 @@ def compare_real(
     )
     if tissue_law is not None:
         scenario.station.tissue_law = tissue_law
+    if surface["offset_m"] != 0.0:
+        # The controller reads the published map, as the real one read its own.
+        scenario.variations.map_errors.surface_offset_m = -surface["offset_m"]
+    if tissue_law is not None or surface["offset_m"] != 0.0:
         scenario.validate()
     if progress:
         progress(scenario.description)
@@ -213,11 +235,27 @@ def compare_real(
     out.update(motion_info)
     out["controller_identified"] = identification.as_dict()
     out["tissue_law"] = scenario.station.tissue_law
+    out.update(_surface_keys(surface))
     seen = real[real["t_s"] <= result.df["t_s"].iloc[-1] + metrics["time_offset_s"]]
     out.update(compare_contact_loss(result.df, seen))
     if return_frames:
         return out, result.df, real
     return out
+
+
+def _surface_keys(surface: dict) -> dict:
+    """compare-real's surface-calibration keys (mm)."""
+    first = surface["first_contact"]
+    ctrl = surface["controller_map_offset_m"]
+    return {
+        "surface_offset_mm": 1e3 * surface["offset_m"],
+        "surface_offset_source": surface["source"],
+        "surface_first_contact_mm": None if first is None else 1e3 * first.offset_m,
+        "surface_first_contact_sigma_mm": None
+        if first is None
+        else 1e3 * first.sigma_m,
+        "controller_map_offset_mm": None if ctrl is None else 1e3 * ctrl,
+    }
 
 
 __all__ = ["compare_real", "phantom_replay"]
