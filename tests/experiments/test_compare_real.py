@@ -6,6 +6,7 @@ import pytest
 
 from vic_drake.analysis.real_comparison import COMPARE_REAL_KEYS
 from vic_drake.experiments.compare_real import compare_real
+from vic_drake.realdata import RIG_SURFACE_OFFSET_M
 
 #: Keys every compare-real result holds besides the contract keys.
 MOTION_KEYS = (
@@ -64,8 +65,9 @@ def test_compare_real_reports_the_motion_and_contact_loss(
     moved = sim["phantom_lift_m"].abs().max()
     assert bool(moved > 1e-4) is replayed
     assert ("lift_max_mm" in out) is replayed
-    # No surface offset by default; a 9-column log holds no evidence of one.
-    assert out["surface_offset_mm"] == 0.0 and out["surface_offset_source"] == "none"
+    # A 9-column log holds no evidence of its own: the rig default applies.
+    assert out["surface_offset_mm"] == pytest.approx(1e3 * RIG_SURFACE_OFFSET_M)
+    assert out["surface_offset_source"] == "rig default"
     assert out["surface_first_contact_mm"] is None
     assert out["controller_map_offset_mm"] is None
 

@@ -24,7 +24,7 @@ SCAN_LOGS = ("test_compliance_control400", "test_force_control")
 
 
 def test_parse_surface_offset():
-    assert parse_surface_offset(None) == DEFAULT_SURFACE_OFFSET == "none"
+    assert parse_surface_offset(None) == DEFAULT_SURFACE_OFFSET == "auto"
     assert parse_surface_offset("auto") == "auto"
     assert parse_surface_offset(-0.002) == -0.002
     for bad in ("rig", 0.05, float("nan"), "3"):
@@ -48,7 +48,8 @@ def test_rig_default_is_what_the_calibration_logs_give(data_dir):
 @pytest.mark.parametrize(
     ("log", "offset", "source", "expected_mm"),
     [
-        ("test_compliance_control400", None, "none", 0.0),
+        ("test_compliance_control400", "none", "none", 0.0),
+        ("test_compliance_control400", None, "rig default", 1e3 * RIG_SURFACE_OFFSET_M),
         (
             "test_compliance_control400",
             "auto",
@@ -120,3 +121,22 @@ def test_a_simulated_scan_shows_the_offset_compare_real_applied(data_dir):
     first = first_contact_offset(sim, published)
     assert first is not None
     assert 1e3 * first.offset_m == pytest.approx(3.0, abs=0.15)
+
+
+@pytest.mark.realdata
+def test_auto_falls_back_on_the_rig_default_for_a_loose_first_contact(
+    data_dir, monkeypatch
+):
+    import vic_drake.experiments.surface_calibration as calibration
+
+    phantom = load_phantom("measured", data_dir=data_dir, lookup="bilinear")
+    real = real_to_canonical(read_bag(data_dir / "experiments" / "test_tracking5"))
+    first = calibration.first_contact_offset(real, phantom)
+    loose = first._replace(sigma_m=2 * calibration.MAX_FIRST_CONTACT_SIGMA_M)
+    far = first._replace(offset_m=2 * calibration.MAX_SURFACE_OFFSET_M)
+    for bad in (loose, far):
+        monkeypatch.setattr(calibration, "first_contact_offset", lambda *a, b=bad: b)
+        surface = calibration.surface_calibration(real, phantom, "auto")
+        assert surface["source"] == "rig default"
+        assert surface["offset_m"] == RIG_SURFACE_OFFSET_M
+        assert surface["first_contact"] is bad  # still reported

@@ -121,8 +121,8 @@ def register(subparsers) -> None:
         metavar="MM|auto|none",
         default=None,
         help="raise the simulated tissue above the published map: a number of mm, "
-        "'auto' (the log's first contact when it approaches from free space, else "
-        "the rig's default) or 'none' (the default); the controller keeps reading "
+        "'auto' (the default: the log's first contact when it approaches from free "
+        "space, else the rig's default) or 'none'; the controller keeps reading "
         "the published map",
     )
     p.add_argument(

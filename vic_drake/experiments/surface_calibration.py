@@ -4,7 +4,9 @@
 simulated tissue by (the controller keeps reading the published map, as the
 real one read its own): a number given by the caller; "auto", the log's own
 first-contact estimate when the log approaches from free space
-(:func:`vic_drake.analysis.surface_offset.first_contact_offset`), else the
+(:func:`vic_drake.analysis.surface_offset.first_contact_offset`) and the
+estimate is plausible (within +-MAX_SURFACE_OFFSET_M, 1-sigma at most
+MAX_FIRST_CONTACT_SIGMA_M), else the
 rig's default :data:`vic_drake.realdata.RIG_SURFACE_OFFSET_M` (which
 :func:`rig_surface_offset` recomputes from the calibration logs); "none",
 no offset. compare-real's default is :data:`DEFAULT_SURFACE_OFFSET`.
@@ -30,7 +32,10 @@ MAX_SURFACE_OFFSET_M = 0.02
 SURFACE_OFFSET_MODES = ("none", "auto")
 #: compare-real's default (docs/decisions.md, "Surface calibration of
 #: compare-real").
-DEFAULT_SURFACE_OFFSET = "none"
+DEFAULT_SURFACE_OFFSET = "auto"
+#: Largest 1-sigma of a first-contact estimate that "auto" uses, m; a
+#: looser fit (a noisy or irregular approach) falls back on the rig default.
+MAX_FIRST_CONTACT_SIGMA_M = 0.0005
 #: Where the offset came from (``surface_offset_source`` of compare-real).
 SURFACE_OFFSET_SOURCES = ("none", "given", "first contact", "rig default")
 
@@ -94,9 +99,17 @@ def surface_calibration(real, phantom, offset=None) -> dict:
         return {**out, "offset_m": 0.0, "source": "none"}
     if offset != "auto":
         return {**out, "offset_m": offset, "source": "given"}
-    if first is not None:
+    if first is not None and _plausible(first):
         return {**out, "offset_m": first.offset_m, "source": "first contact"}
     return {**out, "offset_m": RIG_SURFACE_OFFSET_M, "source": "rig default"}
+
+
+def _plausible(first) -> bool:
+    """A first-contact estimate "auto" may use: in range and a tight fit."""
+    return (
+        abs(first.offset_m) <= MAX_SURFACE_OFFSET_M
+        and first.sigma_m <= MAX_FIRST_CONTACT_SIGMA_M
+    )
 
 
 def rig_surface_offset(bags, phantom) -> dict:
@@ -139,6 +152,7 @@ def rig_surface_offset(bags, phantom) -> dict:
 
 __all__ = [
     "DEFAULT_SURFACE_OFFSET",
+    "MAX_FIRST_CONTACT_SIGMA_M",
     "MAX_SURFACE_OFFSET_M",
     "SURFACE_OFFSET_MODES",
     "SURFACE_OFFSET_SOURCES",
