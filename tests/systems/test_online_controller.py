@@ -93,3 +93,70 @@ def test_scenario_validates_the_source(field, value):
     setattr(s, field, value)
     with pytest.raises(VicDrakeError, match=field):
         s.validate()
+
+
+DITHERED_ONLINE = """\
+stiffness_source: online
+controller: {reference: {controller: vs-vf, penetration_dither_m: 0.0003,
+                         penetration_dither_hz: 3.0}}
+online_estimator: {method: ekf, surface_from_slope: true,
+                   surface_walk_m_per_sqrt_s: 0.0}
+"""
+
+
+def test_dithered_online_scenario_loads_from_yaml():
+    from vic_drake.scenario import loads_scenario
+
+    s = loads_scenario(DITHERED_ONLINE)
+    assert s.controller.reference.penetration_dither_m == 0.0003
+    assert s.online_estimator.surface_from_slope is True
+
+
+@pytest.mark.parametrize(
+    "text, match",
+    [
+        (
+            DITHERED_ONLINE.replace(
+                "penetration_dither_m: 0.0003", "penetration_dither_m: 0.0"
+            ),
+            r"online_estimator\.surface_from_slope needs the reference's dither",
+        ),
+        (
+            DITHERED_ONLINE.replace("0.0003", "0.005"),
+            r"penetration_dither_m must be in \[0, eps_d_m / 2\].*0\.005",
+        ),
+        (
+            DITHERED_ONLINE.replace(
+                "penetration_dither_hz: 3.0", "penetration_dither_hz: 0"
+            ),
+            r"penetration_dither_hz must be > 0",
+        ),
+        (
+            DITHERED_ONLINE.replace(
+                "surface_from_slope: true", "surface_from_slope: 1"
+            ),
+            "surface_from_slope",
+        ),
+        (
+            DITHERED_ONLINE.replace("method: ekf", "method: rls"),
+            "surface_from_slope needs method 'ekf'",
+        ),
+    ],
+)
+def test_dithered_online_scenario_is_validated(text, match):
+    from vic_drake.scenario import loads_scenario
+
+    with pytest.raises(VicDrakeError, match=match):
+        loads_scenario(text)
+
+
+def test_controller_refuses_the_slope_surface_without_the_dither():
+    with pytest.raises(
+        VicDrakeError, match="surface_from_slope needs the reference's dither"
+    ):
+        MakeVariableImpedanceController(
+            _params(),
+            phantom=None,
+            stiffness_source="online",
+            estimator=OnlineEstimatorParams(method="ekf", surface_from_slope=True),
+        )

@@ -228,6 +228,14 @@ class ReferenceParams:
             map height under the probe) or "gradient" (grad z . (vx, vy),
             instantaneous).
         surface_velocity_window: samples in the moving average (>= 1).
+        penetration_dither_m: VS-VF only: amplitude of a sinusoidal dither
+            of the desired penetration, eps_d(t) = eps_d_m +
+            penetration_dither_m sin(2 pi penetration_dither_hz t), m
+            (0 = off, the default; at most eps_d_m / 2). It excites the
+            tissue so that an online estimator can tell kappa from the
+            surface (:func:`vic_drake.control.references.desired_penetration`).
+        penetration_dither_hz: its frequency, Hz (> 0; at most a tenth of
+            the control rate, :class:`ControllerParams`).
     """
 
     controller: str = "vs-cf"
@@ -241,6 +249,8 @@ class ReferenceParams:
     )
     surface_velocity_mode: str = "moving_average"
     surface_velocity_window: int = 10
+    penetration_dither_m: float = 0.0
+    penetration_dither_hz: float = 3.0
 
     def __post_init__(self):
         self.validate()
@@ -280,7 +290,28 @@ class ReferenceParams:
             raise VicDrakeError(
                 f"{o}.surface_velocity_window must be an integer >= 1; got {w!r}"
             )
+        self._validate_dither(o)
         return self
+
+    def _validate_dither(self, o: str) -> None:
+        for name in ("penetration_dither_m", "penetration_dither_hz"):
+            if isinstance(getattr(self, name), bool):
+                raise VicDrakeError(
+                    f"{o}.{name} must be a number; got {getattr(self, name)!r}"
+                )
+        a = check_number(o, "penetration_dither_m", self.penetration_dither_m)
+        if not 0.0 <= a <= 0.5 * self.eps_d_m:
+            raise VicDrakeError(
+                f"{o}.penetration_dither_m must be in [0, eps_d_m / 2] = "
+                f"[0, {0.5 * self.eps_d_m!r}] m (0 = off); got {self.penetration_dither_m!r}"
+            )
+        _positive(o, "penetration_dither_hz", self.penetration_dither_hz)
+        if a > 0.0 and self.controller != "vs-vf":
+            raise VicDrakeError(
+                f"{o}.penetration_dither_m needs controller 'vs-vf' (the only "
+                f"reference with a desired penetration); got controller "
+                f"{self.controller!r} with penetration_dither_m {a!r}"
+            )
 
 
 @dataclass
@@ -303,7 +334,7 @@ class ControllerParams:
         self.validate()
 
     def validate(self) -> "ControllerParams":
-        _positive("ControllerParams", "period_s", self.period_s)
+        period = _positive("ControllerParams", "period_s", self.period_s)
         for name, kind in (
             ("tank", TankParams),
             ("qp", StiffnessQpParams),
@@ -315,6 +346,13 @@ class ControllerParams:
                     f"ControllerParams.{name} must be a {kind.__name__}; got {value!r}"
                 )
             value.validate()
+        hz = self.reference.penetration_dither_hz
+        if hz > 0.1 / period:
+            raise VicDrakeError(
+                "ControllerParams.reference.penetration_dither_hz must be at most "
+                f"a tenth of the control rate (0.1 / period_s = {0.1 / period!r} Hz); "
+                f"got {hz!r}"
+            )
         return self
 
 

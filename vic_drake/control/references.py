@@ -24,6 +24,7 @@ CS and CF do not use the QP; VS-CF and VS-VF feed F_ref and F_min to it.
 
 from __future__ import annotations
 
+import math
 from typing import NamedTuple
 
 from vic_drake.control.params import ReferenceParams, StiffnessQpParams
@@ -110,6 +111,16 @@ def surface_velocity_gradient(
     return dz_dx * vx + dz_dy * vy
 
 
+def desired_penetration(ref: ReferenceParams, t_s: float) -> float:
+    """VS-VF's desired penetration at time t, m: ``eps_d_m``, plus the dither
+    ``penetration_dither_m sin(2 pi penetration_dither_hz t)`` when it is on.
+    """
+    a = ref.penetration_dither_m
+    if a == 0.0:
+        return ref.eps_d_m
+    return ref.eps_d_m + a * math.sin(2.0 * math.pi * ref.penetration_dither_hz * t_s)
+
+
 def force_references(
     *,
     contact: bool,
@@ -119,6 +130,7 @@ def force_references(
     beta: float,
     ref: ReferenceParams,
     qp: StiffnessQpParams,
+    t_s: float = 0.0,
 ) -> ForceReferences:
     """F_ref, F_min and the FDCC target force of the selected controller.
 
@@ -129,12 +141,15 @@ def force_references(
         beta: HC exponent of the map.
         ref: controller kind and reference settings.
         qp: F_min (x, y and out of contact z) and F_max.
+        t_s: the tick's time, s (read only by VS-VF's dither).
 
     Returns:
         ForceReferences. CS: all zero, F_min = qp.force_min_N. CF: F_ref
         and target force (0, 0, -force_ref_N). VS-CF: F_ref,z =
         -force_ref_N and F_min,z = -(kappa + lam eps_dot) eps_max^beta in
-        contact. VS-VF: F_ref,z = -(kappa + lam eps_dot) eps_d^beta and
+        contact. VS-VF: F_ref,z = -(kappa + lam eps_dot) eps_d(t)^beta
+        (:func:`desired_penetration`; with its dither F_min,z is scaled by
+        min(1, (eps_d(t) / eps_d_m)^beta) too) and
         F_min,z = force_min_z_N in contact. Out of contact the VS
         controllers use F_ref = 0, F_min,z = -F_max,z.
     """
@@ -152,8 +167,14 @@ def force_references(
         f_ref_z = -ref.force_ref_N
         f_min_z = -(kappa + lam * eps_dot) * ref.eps_max_m**beta
     else:  # "vs-vf"
-        f_ref_z = -(kappa + lam * eps_dot) * ref.eps_d_m**beta
+        eps_d = desired_penetration(ref, t_s)
+        f_ref_z = -(kappa + lam * eps_dot) * eps_d**beta
         f_min_z = ref.force_min_z_N
+        if eps_d < ref.eps_d_m:
+            # The dither lowers the bound with the reference (where the force
+            # sits at the bound, on ribs, the tip keeps moving), never
+            # raises it.
+            f_min_z *= (eps_d / ref.eps_d_m) ** beta
     return ForceReferences((0.0, 0.0, f_ref_z), (f_min[0], f_min[1], f_min_z), zero)
 
 

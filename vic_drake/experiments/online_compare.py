@@ -1,27 +1,43 @@
 """Closed loop: VS-VF on the true map, on a wrong map, and with online estimates.
 
-:func:`online_comparison` runs the VS-VF scan of one phantom three (four)
-ways and scores each against the TRUE tissue, not against the controller's
-own reference (a controller on a wrong map tracks its own wrong reference
+:func:`online_comparison` runs the VS-VF scan of one phantom several ways
+and scores each against the TRUE tissue, not against the controller's own
+reference (a controller on a wrong map tracks its own wrong reference
 well):
 
 - "true_map": the phantom's own map;
 - "wrong_map_+30" and "wrong_map_-30": kappa x 1.3 / x 0.7, surface + 2 mm
   (``variations.map_errors``);
 - "online": ``stiffness_source: online``, the estimator seeded with its
-  prior (no map).
+  prior (no map);
+- "online_map_surface", "online_wrong_surface": online kappa, lam on the
+  true map's surface / on the map's surface 2 mm high;
+- "..._dither": the same with the penetration dither on
+  (:data:`DITHER_M` at :data:`DITHER_HZ`); "online_dither" also takes its
+  surface from the tissue's slope under the dithered tip
+  (``online_estimator.surface_from_slope``, no EKF surface state). The map
+  runs with the dither show what the dither alone costs.
 
 Scores over the scan window (:func:`vic_drake.analysis.contact.scan_window`):
 
 - ``force_rmse_true_N``: RMS of sensor z force minus the true VS-VF
   reference -kappa_true(x, y) eps_d^beta (the elastic part: the reference
   the controller would use with a perfect map at rest, capped at
-  F_min,z as the QP caps it);
+  F_min,z as the QP caps it). The dither is NOT taken out: its force swing
+  counts as error, so a dithered run pays for it here;
+- ``force_rmse_dithered_truth_N``: the same against the true reference
+  with the run's own dither (eps_d(t), and F_min,z(t) as the dithered
+  references lower it): the error beyond the dither (equal to the above
+  without the dither);
+- ``dither_rms_N``: RMS of the dither's own part of that reference (true
+  dithered minus true undithered; 0 without the dither);
 - ``force_rmse_own_N``: RMS against the controller's own F_ref;
 - ``penetration_err_mm``: median |true penetration - eps_d| (the true
-  surface under the probe minus the tip height);
+  surface under the probe minus the tip height; eps_d without the dither);
 - ``rib_p99_force_N``: 99th percentile of the pressing force where the
-  true kappa exceeds the rib threshold.
+  true kappa exceeds the rib threshold;
+- ``tank_min_J``: the lowest tank energy over the scan window (the tank
+  must stay >= T_min: the dither varies K, which the tank pays for).
 """
 
 from __future__ import annotations
@@ -35,23 +51,35 @@ from vic_drake.analysis.scan_metrics import RIB_KAPPA_THRESHOLD, force_rmse_N
 from vic_drake.experiments.scan_run import run_scan
 from vic_drake.scenario import Scenario
 
+#: The comparison's dither of the desired penetration: amplitude, m, and
+#: frequency, Hz (docs/decisions.md, "Closed loop with a penetration dither").
+DITHER_M = 3e-4
+DITHER_HZ = 3.0
+
 #: The runs of the comparison: name -> (stiffness_source, kappa_scale,
-#: surface_offset_m, online_surface). "online" reads no map at all;
+#: surface_offset_m, online_surface, dither). "online" reads no map at all;
 #: "online_map_surface" takes only the surface from the true map and
 #: "online_wrong_surface" from the map 2 mm too high (kappa, lam online).
 COMPARISON_RUNS = {
-    "true_map": ("map", 1.0, 0.0, "estimated"),
-    "wrong_map_+30": ("map", 1.3, 0.002, "estimated"),
-    "wrong_map_-30": ("map", 0.7, 0.002, "estimated"),
-    "online": ("online", 1.0, 0.0, "estimated"),
-    "online_map_surface": ("online", 1.0, 0.0, "map"),
-    "online_wrong_surface": ("online", 1.0, 0.002, "map"),
+    "true_map": ("map", 1.0, 0.0, "estimated", False),
+    "wrong_map_+30": ("map", 1.3, 0.002, "estimated", False),
+    "wrong_map_-30": ("map", 0.7, 0.002, "estimated", False),
+    "online": ("online", 1.0, 0.0, "estimated", False),
+    "online_map_surface": ("online", 1.0, 0.0, "map", False),
+    "online_wrong_surface": ("online", 1.0, 0.002, "map", False),
+    "true_map_dither": ("map", 1.0, 0.0, "estimated", True),
+    "wrong_map_+30_dither": ("map", 1.3, 0.002, "estimated", True),
+    "wrong_map_-30_dither": ("map", 0.7, 0.002, "estimated", True),
+    "online_dither": ("online", 1.0, 0.0, "estimated", True),
 }
+
+#: The runs of the comparison before the dither (issue 12's first table).
+UNDITHERED_RUNS = tuple(name for name, run in COMPARISON_RUNS.items() if not run[4])
 
 
 def comparison_scenario(base: Scenario, run: str) -> Scenario:
     """The base VS-VF scenario set up for one run of :data:`COMPARISON_RUNS`."""
-    source, kappa_scale, offset, surface = COMPARISON_RUNS[run]
+    source, kappa_scale, offset, surface, dither = COMPARISON_RUNS[run]
     s = copy.deepcopy(base)
     s.name = f"{base.name}_{run}"
     s.stiffness_source = source
@@ -60,7 +88,38 @@ def comparison_scenario(base: Scenario, run: str) -> Scenario:
         s.online_estimator.surface_walk_m_per_sqrt_s = 0.0
     s.variations.map_errors.kappa_scale = kappa_scale
     s.variations.map_errors.surface_offset_m = offset
+    if dither:
+        s.controller.reference.penetration_dither_m = DITHER_M
+        s.controller.reference.penetration_dither_hz = DITHER_HZ
+        if source == "online":  # The surface from the slope, no EKF surface state.
+            s.online_estimator.surface_from_slope = True
+            s.online_estimator.surface_walk_m_per_sqrt_s = 0.0
     return s.validate()
+
+
+def true_references(df, phantom, scenario: Scenario) -> tuple[np.ndarray, np.ndarray]:
+    """(undithered, dithered) true VS-VF z references of every row, N.
+
+    -kappa_true(x, y) eps_d^beta capped at F_min,z, and the same with the
+    run's dither: eps_d(t) and F_min,z(t) as
+    :func:`vic_drake.control.references.force_references` form them.
+    """
+    x, y, t = (df[c].to_numpy(float) for c in ("x_m", "y_m", "t_s"))
+    kappa = np.asarray(phantom.sample(x, y).kappa)
+    ref = scenario.controller.reference
+    beta = phantom.beta
+    plain = np.maximum(-kappa * ref.eps_d_m**beta, ref.force_min_z_N)
+    if ref.penetration_dither_m == 0.0:
+        return plain, plain
+    eps_d = ref.eps_d_m + ref.penetration_dither_m * np.sin(
+        2.0 * np.pi * ref.penetration_dither_hz * t
+    )
+    f_min = ref.force_min_z_N * np.minimum(1.0, (eps_d / ref.eps_d_m) ** beta)
+    return plain, np.maximum(-kappa * eps_d**beta, f_min)
+
+
+def _rms(values: np.ndarray, sel: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(values[sel] ** 2))) if sel.any() else np.nan
 
 
 def score_against_truth(df, phantom, scenario: Scenario) -> dict:
@@ -69,27 +128,29 @@ def score_against_truth(df, phantom, scenario: Scenario) -> dict:
     x, y, z = (df[c].to_numpy(float) for c in ("x_m", "y_m", "z_m"))
     tissue = phantom.sample(x, y)
     ref = scenario.controller.reference
-    # The VS-VF reference on the true tissue, capped by F_min,z as the QP
-    # caps it (sensor convention: pressing is negative).
-    f_true = np.maximum(
-        -np.asarray(tissue.kappa) * ref.eps_d_m**phantom.beta, ref.force_min_z_N
-    )
-    err = df["force_sensor_z_N"].to_numpy(float) - f_true
+    # The VS-VF reference on the true tissue (sensor convention: pressing
+    # is negative).
+    f_true, f_dithered = true_references(df, phantom, scenario)
+    force = df["force_sensor_z_N"].to_numpy(float)
+    err = force - f_true
     contact = df["in_contact"].to_numpy(float) > 0.5
     sel = window & contact & np.isfinite(err)
     pen = np.asarray(tissue.surface_z_m) - z - df["phantom_lift_m"].to_numpy(float)
     rib = window & (np.asarray(tissue.kappa) > RIB_KAPPA_THRESHOLD)
     pressing = pressing_force_N(df)
     return {
-        "force_rmse_true_N": float(np.sqrt(np.mean(err[sel] ** 2)))
-        if sel.any()
-        else np.nan,
+        "force_rmse_true_N": _rms(err, sel),
+        "force_rmse_dithered_truth_N": _rms(force - f_dithered, sel),
+        "dither_rms_N": _rms(f_dithered - f_true, sel),
         "force_rmse_own_N": force_rmse_N(df),
         "penetration_err_mm": float(np.median(np.abs(pen[sel] - ref.eps_d_m)) * 1e3)
         if sel.any()
         else np.nan,
         "rib_p99_force_N": float(np.percentile(pressing[rib], 99))
         if rib.any()
+        else np.nan,
+        "tank_min_J": float(df["tank_energy_J"].to_numpy(float)[window].min())
+        if window.any()
         else np.nan,
     }
 
@@ -98,11 +159,11 @@ def online_comparison(
     base: Scenario,
     *,
     phantom,
-    runs=tuple(COMPARISON_RUNS),
+    runs=UNDITHERED_RUNS,
     duration_s=None,
     progress=None,
 ) -> dict:
-    """{run: scores} for each run (see the module docstring)."""
+    """{run: scores} for each run (see the module docstring), one at a time."""
     out = {}
     for run in runs:
         s = comparison_scenario(base, run)
@@ -111,9 +172,62 @@ def online_comparison(
     return out
 
 
+def comparison_table(scores: dict) -> str:
+    """The scores as a markdown table, one row a run."""
+    cols = (
+        ("force_rmse_true_N", "force RMSE vs truth N", 3),
+        ("force_rmse_dithered_truth_N", "vs dithered truth N", 3),
+        ("dither_rms_N", "dither RMS N", 3),
+        ("penetration_err_mm", "penetration err mm", 2),
+        ("rib_p99_force_N", "p99 force on ribs N", 2),
+        ("tank_min_J", "tank min J", 3),
+    )
+    lines = [
+        "| run | " + " | ".join(c[1] for c in cols) + " |",
+        "|---|" + "---|" * len(cols),
+    ]
+    for run, sc in scores.items():
+        cells = [f"{sc[key]:.{digits}f}" for key, _, digits in cols]
+        lines.append(f"| {run} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def main(argv=None) -> None:
+    """``python -m vic_drake.experiments.online_compare SCENARIO [RUN ...]``:
+    prints the table (every run of :data:`COMPARISON_RUNS` by default)."""
+    import argparse
+
+    from vic_drake.experiments.scan_diagram import load_scenario_phantom
+    from vic_drake.scenario import load_scenario
+
+    parser = argparse.ArgumentParser(description=main.__doc__)
+    parser.add_argument("scenario", help="a VS-VF scenario YAML")
+    parser.add_argument("runs", nargs="*", help="runs to make (default: all)")
+    args = parser.parse_args(argv)
+    unknown = [r for r in args.runs if r not in COMPARISON_RUNS]
+    if unknown:
+        parser.error(f"unknown runs {unknown}; choose from {list(COMPARISON_RUNS)}")
+    base = load_scenario(args.scenario)
+    scores = online_comparison(
+        base,
+        phantom=load_scenario_phantom(base),
+        runs=tuple(args.runs) or tuple(COMPARISON_RUNS),
+    )
+    print(comparison_table(scores))
+
+
 __all__ = [
     "COMPARISON_RUNS",
+    "DITHER_HZ",
+    "DITHER_M",
+    "UNDITHERED_RUNS",
     "comparison_scenario",
+    "comparison_table",
+    "main",
     "online_comparison",
     "score_against_truth",
+    "true_references",
 ]
+
+if __name__ == "__main__":
+    main()

@@ -107,6 +107,21 @@ def _validate_simulator(owner: str, config: SimulatorConfig) -> None:
         )
 
 
+def _validate_slope(owner: str, s) -> None:
+    """The online surface from the slope needs the tip kept moving."""
+    if (
+        s.stiffness_source == "online"
+        and s.online_estimator.surface_from_slope
+        and s.controller.reference.penetration_dither_m == 0.0
+    ):
+        raise VicDrakeError(
+            f"{owner}.online_estimator.surface_from_slope needs the reference's "
+            "dither (controller.reference.penetration_dither_m > 0): at a steady "
+            "depth the tip does not move and the slope is not observable; got "
+            "penetration_dither_m 0.0"
+        )
+
+
 @dataclass
 class Scenario:
     """One closed-loop scan: phantom, station, controller, FDCC, references.
@@ -207,6 +222,7 @@ class Scenario:
                 f"{o}.stiffness_source must be one of {list(STIFFNESS_SOURCES)}; "
                 f"got {self.stiffness_source!r}"
             )
+        _validate_slope(o, self)
         if self.controller_feedback not in CONTROLLER_FEEDBACKS:
             raise VicDrakeError(
                 f"{o}.controller_feedback must be 'measured' or 'command'; "

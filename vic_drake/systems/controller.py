@@ -93,6 +93,12 @@ def MakeVariableImpedanceController(
     if (not online or online_surface == "map") and not isinstance(phantom, Phantom):
         raise VicDrakeError(f"phantom must be a vic_drake Phantom; got {phantom!r}")
     params.validate()
+    if online and estimator.validate().surface_from_slope:
+        if params.reference.penetration_dither_m == 0.0:
+            raise VicDrakeError(
+                "the estimator's surface_from_slope needs the reference's dither "
+                "(reference.penetration_dither_m > 0); got 0.0"
+            )
     builder = DiagramBuilder()
     ref = builder.AddNamedSystem(
         "force_reference",

@@ -155,16 +155,21 @@ class ForceReferenceSystem(LeafSystem):
         filter_state = surface_velocity_initial_state(ref.surface_velocity_window)
         self._filter_index = self.DeclareDiscreteState(filter_state)
         self.DeclarePeriodicDiscreteUpdateEvent(self._dt, 0.0, self._update)
-        # The tick's values, one array (see _evaluate).
+        # The tick's values, one array (see _evaluate); with VS-VF's
+        # penetration dither they depend on the time too.
+        self._dither = ref.penetration_dither_m > 0.0
+        tickets = {
+            self.all_input_ports_ticket(),
+            self.discrete_state_ticket(self._filter_index),
+        }
+        if self._dither:
+            tickets.add(self.time_ticket())
         self._cache = self.DeclareCacheEntry(
             "references",
             ValueProducer(
                 allocate=lambda: AbstractValue.Make(object()), calc=self._calc
             ),
-            {
-                self.all_input_ports_ticket(),
-                self.discrete_state_ticket(self._filter_index),
-            },
+            tickets,
         )
         self._outputs = {}
         if ref.controller == "cf":
@@ -268,6 +273,7 @@ class ForceReferenceSystem(LeafSystem):
             beta=self._beta,
             ref=ref,
             qp=self._params.qp,
+            t_s=context.get_time() if self._dither else 0.0,
         )
         values = [0.0] * REFERENCES_SIZE  # A list: cheaper than numpy per element.
         values[REF_FORCE_REFERENCE] = f_ref

@@ -11,6 +11,9 @@ palpation campaign.
   forgetting at fixed beta.
 - :mod:`~vic_drake.estimation.online.ekf`: EKF with a random-walk state
   (kappa, lam, optionally the surface offset and beta).
+- :mod:`~vic_drake.estimation.online.slope`: the penetration, hence the
+  surface, from the tissue's local slope under a dithered tip (the EKF's
+  surface with ``surface_from_slope``).
 - :mod:`~vic_drake.estimation.online.replay`: run over a recorded log,
   compare with a reference.
 """

@@ -17,6 +17,12 @@ linearised at the current state. Prediction adds the random-walk variance
 of the time since the last update (a contact loss of a few seconds lets
 the estimate move again at re-contact), capped at the prior variance.
 Faulty samples and samples out of contact change nothing.
+
+With ``surface_from_slope`` (:func:`ekf_slope_step`) a fit of the tissue's
+local slope under the moving tip (:mod:`vic_drake.estimation.online.slope`)
+runs alongside: once valid, the surface it measures is the EKF's surface
+input (when the caller gives none) in place of the surface latched at
+first contact. Its state follows the EKF's in one list.
 """
 
 from __future__ import annotations
@@ -24,6 +30,7 @@ from __future__ import annotations
 import math
 
 from vic_drake.estimation.online.core import (
+    AUX_SIZE,
     IN_CONTACT,
     N_CLIPPED,
     N_UPDATES,
@@ -38,6 +45,7 @@ from vic_drake.estimation.online.core import (
     unpack,
 )
 from vic_drake.estimation.online.params import OnlineEstimatorParams
+from vic_drake.estimation.online.slope import slope_initial_state, slope_step
 
 _MM = 1e-3
 
@@ -138,4 +146,40 @@ def ekf_step(
     return aux + x + P, make_estimate(aux, x, P, p, surface, contact)
 
 
-__all__ = ["ekf_initial_state", "ekf_layout", "ekf_step"]
+def ekf_slope_initial_state(params: OnlineEstimatorParams) -> list[float]:
+    """The EKF's state followed by the slope fit's."""
+    return ekf_initial_state(params) + slope_initial_state()
+
+
+def ekf_slope_step(
+    state,
+    t: float,
+    z: float,
+    z_dot: float,
+    force: float,
+    surface_z: float,
+    params: OnlineEstimatorParams,
+) -> tuple[list[float], Estimate]:
+    """:func:`ekf_step` on the slope fit's surface when ``surface_z`` is NaN
+    (arguments and result as :func:`ekf_step`)."""
+    p = params
+    n, _, _ = ekf_layout(p)
+    size = AUX_SIZE + n + n * n
+    state = list(state)
+    ekf_state = state[:size]
+    fit, slope = slope_step(
+        state[size:], t, z, z_dot, force, p, surface_start=ekf_state[S_PREV]
+    )
+    if math.isnan(surface_z):
+        surface_z = slope.surface_z_m
+    ekf_state, est = ekf_step(ekf_state, t, z, z_dot, force, surface_z, p)
+    return ekf_state + fit, est
+
+
+__all__ = [
+    "ekf_slope_initial_state",
+    "ekf_slope_step",
+    "ekf_initial_state",
+    "ekf_layout",
+    "ekf_step",
+]

@@ -74,6 +74,19 @@ class OnlineEstimatorParams:
             rate s_dot (finite differences of the surface input), s.
         max_rel_change: kappa and lam stay within [prior / max_rel_change,
             prior * max_rel_change].
+        surface_from_slope: EKF only: the surface comes from the tissue's
+            local slope under the moving tip
+            (:mod:`vic_drake.estimation.online.slope`) instead of being
+            latched at first contact, once that fit is valid. It needs the
+            tip to keep moving (a dither of the penetration,
+            ``ReferenceParams.penetration_dither_m``).
+        slope_memory_s: forgetting time constant of the slope fit, s.
+        slope_min_motion_m: a solve of the fit counts only when the tip's
+            motion beyond the slow trend has at least this RMS, m.
+        slope_max_rel_std: ... and the relative standard error of the
+            slope is at most this.
+        slope_surface_time_s: time scale of the filter that tracks the
+            fit's surface (1 / its natural frequency), s.
     """
 
     method: str = "rls"
@@ -97,6 +110,11 @@ class OnlineEstimatorParams:
     max_gap_s: float = 0.02
     surface_rate_time_constant_s: float = 0.02
     max_rel_change: float = 20.0
+    surface_from_slope: bool = False
+    slope_memory_s: float = 0.2
+    slope_min_motion_m: float = 5e-5
+    slope_max_rel_std: float = 0.05
+    slope_surface_time_s: float = 0.5
 
     def __post_init__(self):
         self.validate()
@@ -132,6 +150,22 @@ class OnlineEstimatorParams:
             raise VicDrakeError(
                 "OnlineEstimatorParams.estimate_beta must be true or false; "
                 f"got {self.estimate_beta!r}"
+            )
+        _number("slope_memory_s", self.slope_memory_s, low=0.0, low_open=True)
+        _number("slope_min_motion_m", self.slope_min_motion_m, low=0.0)
+        _number("slope_max_rel_std", self.slope_max_rel_std, low=0.0, low_open=True)
+        _number(
+            "slope_surface_time_s", self.slope_surface_time_s, low=0.0, low_open=True
+        )
+        if not isinstance(self.surface_from_slope, bool):
+            raise VicDrakeError(
+                "OnlineEstimatorParams.surface_from_slope must be true or false; "
+                f"got {self.surface_from_slope!r}"
+            )
+        if self.surface_from_slope and self.method != "ekf":
+            raise VicDrakeError(
+                "OnlineEstimatorParams.surface_from_slope needs method 'ekf'; got "
+                f"method {self.method!r}"
             )
         if self.estimate_beta and self.method != "ekf":
             raise VicDrakeError(

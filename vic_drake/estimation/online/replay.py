@@ -16,7 +16,12 @@ import numpy as np
 
 from vic_drake.errors import VicDrakeError
 from vic_drake.estimation.online.core import OUTPUT_FIELDS
-from vic_drake.estimation.online.ekf import ekf_initial_state, ekf_step
+from vic_drake.estimation.online.ekf import (
+    ekf_initial_state,
+    ekf_slope_initial_state,
+    ekf_slope_step,
+    ekf_step,
+)
 from vic_drake.estimation.online.params import OnlineEstimatorParams
 from vic_drake.estimation.online.rls import rls_initial_state, rls_step
 
@@ -29,6 +34,8 @@ def estimator_functions(params: OnlineEstimatorParams):
     params.validate()
     if params.method == "rls":
         return rls_initial_state, rls_step
+    if params.surface_from_slope:
+        return ekf_slope_initial_state, ekf_slope_step
     return ekf_initial_state, ekf_step
 
 

@@ -1,0 +1,268 @@
+"""The tissue's penetration from its local slope under a moving probe.
+
+At a steady depth the force ``F = kappa eps^beta`` fits a whole curve of
+(kappa, surface) pairs: the two are not separately observable. When the
+tip moves (a dither of the penetration keeps it moving), the tissue answers
+with its local slope ``k = dF/d eps = beta kappa eps^(beta - 1)``, and with
+the force level F
+
+    eps = beta F / k,        surface = z + eps,
+
+whatever kappa is. :func:`slope_step` fits, by least squares with
+exponential forgetting (time constant ``slope_memory_s``),
+
+    F(t) = a0 + a1 tau + a2 tau^2 + a3 tau^3 - k (z - z0) - c z_dot
+
+(tau = time since now): the cubic takes the slow change of the force as
+the probe travels over the body, so that k and c (the local damping) come
+from the part of the tip's motion that the cubic does not explain: the
+dither and whatever else the loop does (the fit does not need the dither's
+frequency). The fit takes z as the penetration's motion: it does not model
+the surface under the tip moving with the tip's sideways sway (friction
+follows the force, so that sway cannot be a regressor).
+
+The sums are accumulated every sample (pure Python floats); the 6 x 6
+solve runs every :data:`SOLVE_EVERY` samples, after re-centring time and
+the height on the newest data. A solve is valid once the contact has
+lasted ``2 slope_memory_s``, the tip's motion beyond the trend has an RMS
+of at least ``slope_min_motion_m``, k's relative standard error (from the
+fit's residuals) is at most ``slope_max_rel_std``, k > 0 and
+0 < eps < :data:`MAX_PENETRATION_M`. Its surface ``mean z + eps`` holds at
+the weighted mean time of the data; the output surface tracks it (brought
+to now with the tracked rate) through a second-order filter (see
+:func:`slope_step`). Everything restarts at each loss of contact.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+
+from vic_drake.estimation.online.params import OnlineEstimatorParams
+
+#: Samples between two solves of the fit.
+SOLVE_EVERY = 10
+#: Largest penetration the slope estimate accepts, m (beyond: not valid).
+MAX_PENETRATION_M = 0.05
+#: The surface filter's error is clipped at this, m: a bad solve moves the
+#: surface at a bounded rate.
+MAX_SURFACE_ERROR_M = 1e-3
+_DEGREE = 3  # of the trend in time
+_N = _DEGREE + 3  # 1, tau, tau^2, tau^3, -(z - z0), -z_dot
+_Z = _DEGREE + 1  # the column of -(z - z0)
+_PAIRS = [(i, j) for i in range(_N) for j in range(i, _N)]
+
+# State layout.
+_T_REF = 0  # time the basis is centred on (NaN: no sample since the reset)
+_Z_REF = 1
+_T_START = 2  # first contact sample since the reset
+_T_LAST = 3  # last good sample
+_COUNT = 4  # samples since the last solve
+_G = 5  # the upper triangle of the Gram matrix
+_B = _G + len(_PAIRS)  # its right-hand side (the force)
+_FF = _B + _N  # the weighted sum of the squared forces
+_SLOPE = _FF + 1  # k of the last solve, N/m (NaN: none)
+_REL_STD = _SLOPE + 1  # its relative standard error
+_MOTION = _REL_STD + 1  # RMS of the tip's motion beyond the trend, m
+_VALID = _MOTION + 1  # 1 if the last solve was valid
+_EPS = _VALID + 1  # penetration of the last valid solve, m (NaN: none)
+_Z_MEAN = _EPS + 1  # mean tip height of the last solve's data, m
+_T_MEAN = _Z_MEAN + 1  # its weighted mean time, s
+_S_OUT = _T_MEAN + 1  # the tracked surface, m (NaN: none)
+_V_OUT = _S_OUT + 1  # its rate, m/s
+SLOPE_SIZE = _V_OUT + 1
+
+
+class SlopeEstimate(NamedTuple):
+    """One sample's output of :func:`slope_step`.
+
+    Attributes:
+        surface_z_m: the tracked surface height (NaN before the first
+            valid solve since contact), m.
+        penetration_m: eps of the last valid solve (NaN before the first
+            since contact), m.
+        slope_N_per_m: k of the last solve (NaN before one).
+        slope_rel_std: its relative standard error (NaN before one).
+        motion_m: RMS of the tip's motion beyond the trend in the last
+            solve's data (0 before one), m.
+        valid: 1.0 if the last solve was valid, else 0.0.
+    """
+
+    surface_z_m: float
+    penetration_m: float
+    slope_N_per_m: float
+    slope_rel_std: float
+    motion_m: float
+    valid: float
+
+
+def slope_initial_state() -> list[float]:
+    """A fresh fit: no sample, no estimate."""
+    state = [0.0] * SLOPE_SIZE
+    for i in (
+        _T_REF, _T_START, _T_LAST, _SLOPE, _REL_STD, _EPS, _Z_MEAN, _T_MEAN, _S_OUT
+    ):  # fmt: skip
+        state[i] = math.nan
+    return state
+
+
+def _solve(s: list[float], t: float, p: OnlineEstimatorParams) -> None:
+    """Re-centres the sums on t and the mean heights, then solves (in place)."""
+    G = np.zeros((_N, _N))
+    for k, (i, j) in enumerate(_PAIRS):
+        G[i, j] = G[j, i] = s[_G + k]
+    b = np.array(s[_B : _B + _N])
+    w0 = G[0, 0]
+    d = t - s[_T_REF]
+    dz = -G[0, _Z] / w0  # mean z - z0
+    # tau_new = tau_old - d: (tau - d)^i = sum_j C(i, j) (-d)^(i - j) tau^j.
+    A = np.eye(_N)
+    for i in range(1, _DEGREE + 1):
+        for j in range(i):
+            A[i, j] = math.comb(i, j) * (-d) ** (i - j)
+    A[_Z, 0] = dz
+    scale = math.exp(-d / p.slope_memory_s)
+    G = scale * (A @ G @ A.T)
+    b = scale * (A @ b)
+    s[_FF] *= scale
+    for k, (i, j) in enumerate(_PAIRS):
+        s[_G + k] = float(G[i, j])
+    s[_B : _B + _N] = b.tolist()
+    s[_T_REF] = t
+    s[_Z_REF] += dz
+    s[_COUNT] = 0.0
+    w0 = G[0, 0]
+    s[_Z_MEAN] = s[_Z_REF]
+    s[_T_MEAN] = t + G[0, 1] / w0
+    s[_VALID] = 0.0
+    unit_z = np.zeros(_N)
+    unit_z[_Z] = 1.0
+    try:
+        trend = np.linalg.solve(G[:_Z, :_Z], G[:_Z, _Z])
+        coef, g_inv_z = np.linalg.solve(G, np.column_stack([b, unit_z])).T
+    except np.linalg.LinAlgError:
+        return
+    motion2 = (G[_Z, _Z] - G[_Z, :_Z] @ trend) / w0
+    slope = float(coef[_Z])
+    # Weighted mean squared residual, and the variance of k: sigma^2 G^-1
+    # scaled by sum w^2 / sum w, which is 1/2 for exponential weights.
+    residual2 = max(s[_FF] - float(coef @ b), 0.0) / w0
+    var_k = residual2 * float(g_inv_z[_Z]) * 0.5
+    s[_SLOPE] = slope
+    s[_REL_STD] = math.sqrt(max(var_k, 0.0)) / abs(slope) if slope != 0.0 else math.inf
+    s[_MOTION] = math.sqrt(max(float(motion2), 0.0))
+    eps = p.beta * float(b[0]) / w0 / slope if slope > 0.0 else math.nan
+    ok = (
+        t - s[_T_START] >= 2.0 * p.slope_memory_s
+        and s[_MOTION] >= p.slope_min_motion_m
+        and s[_REL_STD] <= p.slope_max_rel_std
+        and 0.0 < eps < MAX_PENETRATION_M
+    )
+    if ok:
+        s[_VALID] = 1.0
+        s[_EPS] = eps
+
+
+def slope_step(
+    state,
+    t: float,
+    z: float,
+    z_dot: float,
+    force: float,
+    params: OnlineEstimatorParams,
+    surface_start: float = math.nan,
+) -> tuple[list[float], SlopeEstimate]:
+    """One sample of the fit and of the surface it measures.
+
+    The output surface tracks ``m = mean z + eps + v (t - mean time)`` (the
+    last solve's mean tip height, eps of the last valid solve, held while
+    the solves are not valid: where the force is capped or the stiffness
+    saturates the tip stops moving, and the probe, pressing with a steady
+    force, keeps its penetration; v the tracked rate) through a filter of
+    natural frequency w = 1 / ``slope_surface_time_s`` that follows a ramp
+    without lag (``s' = v + 2 w e``, ``v' = w^2 e``, e = m - s clipped at
+    :data:`MAX_SURFACE_ERROR_M`). It is slower than the probe's own motion
+    on purpose: within that time the surface stays put under a probe that
+    presses deeper (a surface that followed the tip at once would read
+    every change of force as a change of kappa). It starts at
+    ``surface_start`` when that is finite (the surface the caller used
+    until now: no jump), else at the first valid solve's.
+
+    Args:
+        state: from :func:`slope_initial_state` (not modified).
+        t: time, s (a sample not after the last good one is ignored).
+        z, z_dot: tip height, m, and its rate, m/s.
+        force: tissue force on the probe, N (positive = pushing it up);
+            at or below ``params.contact_threshold_N`` everything restarts.
+        params: ``slope_memory_s``, ``slope_min_motion_m``,
+            ``slope_surface_time_s``, ``beta``, ``contact_threshold_N``.
+        surface_start: see above, m.
+
+    Returns:
+        (new state, :class:`SlopeEstimate`).
+    """
+    p = params
+    s = list(state)
+    if not math.isfinite(t + z + z_dot + force) or not (
+        math.isnan(s[_T_LAST]) or t > s[_T_LAST]
+    ):
+        return s, _estimate(s)
+    dt = 0.0 if math.isnan(s[_T_LAST]) else t - s[_T_LAST]
+    if force <= p.contact_threshold_N:
+        s = slope_initial_state()
+        s[_T_LAST] = t
+        return s, _estimate(s)
+    s[_T_LAST] = t
+    if math.isnan(s[_T_REF]):
+        s[_T_REF] = s[_T_START] = t
+        s[_Z_REF] = z
+    tau = t - s[_T_REF]
+    w = math.exp(tau / p.slope_memory_s)
+    tau2 = tau * tau
+    phi = (1.0, tau, tau2, tau2 * tau, s[_Z_REF] - z, -z_dot)
+    k = _G
+    for i in range(_N):
+        wi = w * phi[i]
+        for j in range(i, _N):
+            s[k] += wi * phi[j]
+            k += 1
+    wf = w * force
+    for i in range(_N):
+        s[_B + i] += wf * phi[i]
+    s[_FF] += wf * force
+    s[_COUNT] += 1.0
+    if s[_COUNT] >= SOLVE_EVERY:
+        _solve(s, t, p)
+    if math.isfinite(s[_EPS]):
+        v = s[_V_OUT]
+        measured = s[_Z_MEAN] + s[_EPS] + v * (t - s[_T_MEAN])
+        if math.isnan(s[_S_OUT]):
+            start = surface_start if math.isfinite(surface_start) else measured
+            s[_S_OUT], s[_V_OUT] = start, 0.0
+        else:
+            wn = 1.0 / p.slope_surface_time_s
+            e = min(
+                max(measured - s[_S_OUT], -MAX_SURFACE_ERROR_M), MAX_SURFACE_ERROR_M
+            )
+            s[_S_OUT] += dt * (v + 2.0 * wn * e)
+            s[_V_OUT] += dt * wn * wn * e
+    return s, _estimate(s)
+
+
+def _estimate(s: list[float]) -> SlopeEstimate:
+    return SlopeEstimate(
+        s[_S_OUT], s[_EPS], s[_SLOPE], s[_REL_STD], s[_MOTION], s[_VALID]
+    )
+
+
+__all__ = [
+    "MAX_PENETRATION_M",
+    "MAX_SURFACE_ERROR_M",
+    "SLOPE_SIZE",
+    "SOLVE_EVERY",
+    "SlopeEstimate",
+    "slope_initial_state",
+    "slope_step",
+]
