@@ -28,7 +28,7 @@ from pydrake.systems.primitives import (
 
 from vic_drake.errors import VicDrakeError
 from vic_drake.experiments.rig_log import add_rig_loggers
-from vic_drake.experiments.scan_logs import LATERAL_LOG_GROUP, LOG_GROUPS
+from vic_drake.experiments.scan_logs import log_groups
 from vic_drake.experiments.scan_variations import (
     add_sensor_faults,
     controller_map,
@@ -233,19 +233,17 @@ def MakeScanDiagram(scenario: Scenario, *, phantom=None, meshcat=None, data_dir=
     )
     # Port 0: the lift (a PatientMotionSource's second port is the lateral one).
     builder.Connect(lift.get_output_port(0), station.GetInputPort("phantom.lift"))
-    groups = LOG_GROUPS
     if lateral:
         builder.Connect(
             motion.get_phantom_lateral_output_port(),
             station.GetInputPort("phantom.lateral"),
         )
-        groups = (*LOG_GROUPS, LATERAL_LOG_GROUP)
 
     sources = {
         system.get_name(): system for system in (station, controller, fdcc, target)
     }
     loggers = {}
-    for group in groups:
+    for group in log_groups(lateral):
         port = sources[group.source].GetOutputPort(group.port)
         if port.size() != len(group.fields):
             raise VicDrakeError(

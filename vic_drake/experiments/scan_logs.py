@@ -155,7 +155,12 @@ LATERAL_LOG_GROUP = LogGroup(
     {"x": "phantom_x_m", "y": "phantom_y_m"},
 )
 #: The columns :data:`LATERAL_LOG_GROUP` adds.
-LATERAL_COLUMNS = ("phantom_x_m", "phantom_y_m")
+LATERAL_COLUMNS = tuple(LATERAL_LOG_GROUP.columns.values())
+
+
+def log_groups(lateral: bool) -> tuple[LogGroup, ...]:
+    """The scan's log groups: :data:`LOG_GROUPS`, and the lateral one if asked."""
+    return (*LOG_GROUPS, LATERAL_LOG_GROUP) if lateral else LOG_GROUPS
 
 
 def logs_to_frame(loggers: dict, root_context) -> pd.DataFrame:
@@ -168,10 +173,9 @@ def logs_to_frame(loggers: dict, root_context) -> pd.DataFrame:
         root_context: the scan diagram's root context after the simulation.
     """
     lateral = LATERAL_LOG_GROUP.name in loggers
-    groups = (*LOG_GROUPS, LATERAL_LOG_GROUP) if lateral else LOG_GROUPS
     data = {}
     t = None
-    for group in groups:
+    for group in log_groups(lateral):
         log = loggers[group.name].FindLog(root_context)
         if t is None:
             t = log.sample_times().copy()
@@ -191,5 +195,6 @@ __all__ = [
     "LOG_GROUPS",
     "XYZ",
     "LogGroup",
+    "log_groups",
     "logs_to_frame",
 ]
