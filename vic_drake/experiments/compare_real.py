@@ -254,6 +254,8 @@ def compare_real(
     out.update(_surface_keys(surface))
     seen = real[real["t_s"] <= result.df["t_s"].iloc[-1] + metrics["time_offset_s"]]
     out.update(compare_contact_loss(result.df, seen))
+    # Added after the keys of earlier versions, whose order is kept.
+    out.update(_lift_off_keys(surface["lift_off"], surface["profile"]))
     if return_frames:
         return out, result.df, real
     return out
@@ -271,7 +273,6 @@ def _surface_keys(surface: dict) -> dict:
         if first is None
         else 1e3 * first.sigma_m,
         "controller_map_offset_mm": None if ctrl is None else 1e3 * ctrl,
-        **_lift_off_keys(surface["lift_off"], surface["profile"]),
     }
 
 
