@@ -140,3 +140,160 @@ def test_auto_falls_back_on_the_rig_default_for_a_loose_first_contact(
         assert surface["source"] == "rig default"
         assert surface["offset_m"] == RIG_SURFACE_OFFSET_M
         assert surface["first_contact"] is bad  # still reported
+
+
+def _anchors(real, phantom):
+    """A plausible first contact at the track's start and a plausible
+    lift-off at its end (the real first contact, a lift-off put beside it)."""
+    import vic_drake.experiments.surface_calibration as calibration
+    from vic_drake.analysis.lift_off import LiftOff
+
+    first = calibration.first_contact_offset(real, phantom)
+    lift = LiftOff(
+        offset_m=-0.001, sigma_m=5e-5, surface_z_m=0.1, x_m=-0.147, y_m=-0.354,
+        t_s=21.0, samples=40, bias_N=0.0, speed_m_per_s=0.04, raw_offset_m=-0.001,
+        kappa_scale=1.0,
+    )  # fmt: skip
+    return first, lift
+
+
+@pytest.mark.realdata
+def test_auto_profile_between_two_plausible_anchors_and_its_fallbacks(
+    data_dir, monkeypatch
+):
+    import vic_drake.experiments.surface_calibration as calibration
+
+    phantom = load_phantom("measured", data_dir=data_dir, lookup="bilinear")
+    real = real_to_canonical(read_bag(data_dir / "experiments" / "test_tracking5"))
+    first, lift = _anchors(real, phantom)
+
+    def use(lift_off):
+        monkeypatch.setattr(calibration, "lift_off_offset", lambda *a, **k: lift_off)
+        return calibration.surface_calibration(real, phantom, "auto")
+
+    surface = use(lift)
+    assert surface["source"] == "first contact + lift-off"
+    assert surface["profile"]["x_m"] == [lift.x_m, first.x_m]  # increasing x
+    assert surface["profile"]["offset_m"] == [lift.offset_m, first.offset_m]
+    assert surface["offset_m"] == pytest.approx((lift.offset_m + first.offset_m) / 2)
+    # A lift that does not follow the model (the real ones: 1.9, 2.1), a
+    # loose one, or one beside the first contact: the first contact alone.
+    for bad in (
+        lift._replace(kappa_scale=1.6),
+        lift._replace(kappa_scale=0.6),
+        lift._replace(sigma_m=2 * calibration.MAX_FIRST_CONTACT_SIGMA_M),
+        lift._replace(x_m=first.x_m - 0.5 * calibration.MIN_PROFILE_SPAN_M),
+    ):
+        surface = use(bad)
+        assert surface["source"] == "first contact" and surface["profile"] is None
+        assert surface["offset_m"] == first.offset_m
+        assert surface["lift_off"] is bad  # still reported
+    # The lift-off alone, when the first contact is not plausible.
+    monkeypatch.setattr(
+        calibration,
+        "first_contact_offset",
+        lambda *a: first._replace(offset_m=2 * calibration.MAX_SURFACE_OFFSET_M),
+    )
+    surface = use(lift)
+    assert surface["source"] == "lift-off" and surface["offset_m"] == lift.offset_m
+    # A number or "none" never applies the anchors.
+    given = calibration.surface_calibration(real, phantom, 0.001)
+    assert given["source"] == "given" and given["profile"] is None
+    assert given["offset_m"] == 0.001
+    assert calibration.surface_calibration(real, phantom, "none")["offset_m"] == 0.0
+
+
+@pytest.mark.realdata
+def test_the_real_lift_offs_are_not_used(data_dir):
+    """Both VS logs lift off, but their lifts do not follow the map's
+    viscosity (fit modulus ~2x the map's kappa): auto keeps the first contact."""
+    phantom = load_phantom("measured", data_dir=data_dir, lookup="bilinear")
+    for name in VS_LOGS:
+        real = real_to_canonical(read_bag(data_dir / "experiments" / name))
+        surface = surface_calibration(real, phantom, "auto")
+        assert surface["lift_off"] is not None
+        assert surface["lift_off"].kappa_scale > 1.8
+        assert surface["source"] == "first contact" and surface["profile"] is None
+    for name in SCAN_LOGS:
+        real = real_to_canonical(read_bag(data_dir / "experiments" / name))
+        assert surface_calibration(real, phantom, "auto")["lift_off"] is None
+
+
+@pytest.mark.realdata
+def test_compare_real_with_a_profile_raises_the_tissue_not_the_controllers_map(
+    data_dir, monkeypatch
+):
+    import vic_drake.experiments.surface_calibration as calibration
+
+    module = importlib.import_module("vic_drake.experiments.compare_real")
+    published = load_phantom("measured", data_dir=data_dir, lookup="bilinear")
+    bag = data_dir / "experiments" / "test_tracking5"
+    first, lift = _anchors(real_to_canonical(read_bag(bag)), published)
+    monkeypatch.setattr(calibration, "lift_off_offset", lambda *a, **k: lift)
+    built = {}
+
+    def build_only(scenario, *, phantom, controller_phantom=None, **_):
+        built.update(scenario=scenario, phantom=phantom, ctrl=controller_phantom)
+        raise _Built
+
+    monkeypatch.setattr(module, "run_scan", build_only)
+    with pytest.raises(_Built):
+        compare_real(bag, data_dir=data_dir)
+    x, y = np.array([-0.155, lift.x_m, -0.05, first.x_m, 0.04]), np.full(5, -0.356)
+    raised = built["phantom"].surface_z(x, y) - published.surface_z(x, y)
+    expected = [lift.offset_m, lift.offset_m, None, first.offset_m, first.offset_m]
+    expected[2] = np.interp(
+        -0.05, [lift.x_m, first.x_m], [lift.offset_m, first.offset_m]
+    )
+    np.testing.assert_allclose(raised, expected, atol=2e-5)  # bilinear between nodes
+    assert built["scenario"].variations.map_errors.surface_offset_m == 0.0
+    seen = controller_map(built["scenario"], built["ctrl"])
+    np.testing.assert_allclose(
+        seen.surface_z(x, y), published.surface_z(x, y), atol=1e-12
+    )
+
+
+def test_surface_profile_raises_a_grid_along_x():
+    from vic_drake.tissue.phantom import GridPhantom
+    from vic_drake.tissue.phantom.distorted import with_surface_profile
+
+    xs, ys = np.linspace(-0.2, 0.1, 31), np.linspace(-0.4, -0.3, 11)
+    flat = GridPhantom(
+        x_m=xs, y_m=ys, z_m=np.full((31, 11), 0.1), kappa=np.full((31, 11), 3e3),
+        lam=np.full((31, 11), 3e4), surface_offset_m=0.0025,
+    )  # fmt: skip
+    raised = with_surface_profile(flat, [-0.1, 0.0], [0.002, -0.001])
+    x = np.array([-0.15, -0.1, -0.05, 0.0, 0.05])
+    np.testing.assert_allclose(
+        raised.surface_z(x, -0.35) - flat.surface_z(x, -0.35),
+        [0.002, 0.002, 0.0005, -0.001, -0.001],
+        atol=1e-12,
+    )
+    np.testing.assert_allclose(raised.surface_gradient(-0.05, -0.35)[0], -0.03)
+    np.testing.assert_allclose(raised.kappa(x, -0.35), flat.kappa(x, -0.35))
+    for bad in (([0.0, -0.1], [0.0, 0.0]), ([0.0], [0.0]), ([0.0, 0.1], [0.0, np.nan])):
+        with pytest.raises(VicDrakeError, match="surface profile"):
+            with_surface_profile(flat, *bad)
+    with pytest.raises(VicDrakeError, match="grid phantom"):
+        with_surface_profile(object(), [0.0, 0.1], [0.0, 0.0])
+
+
+@pytest.mark.slow
+@pytest.mark.realdata
+def test_a_simulated_lift_off_reads_the_known_surface(data_dir):
+    """tracking5 simulated whole on relaxing tissue 3 mm above the map: the
+    lift-off read from the simulated log finds the 3 mm (measured 3.14)."""
+    from vic_drake.analysis.lift_off import lift_off_offset
+
+    _, sim, _ = compare_real(
+        data_dir / "experiments" / "test_tracking5",
+        data_dir=data_dir,
+        surface_offset=0.003,
+        return_frames=True,
+    )
+    published = load_phantom("measured", data_dir=data_dir, lookup="bilinear")
+    found = lift_off_offset(sim, published)
+    assert 1e3 * found.offset_m == pytest.approx(3.0, abs=0.2)
+    assert found.kappa_scale == pytest.approx(1.0, abs=0.1)
+    plain = lift_off_offset(sim, published, viscous=False)
+    assert abs(1e3 * plain.offset_m - 3.0) > 0.3

@@ -121,8 +121,9 @@ def register(subparsers) -> None:
         metavar="MM|auto|none",
         default=None,
         help="raise the simulated tissue above the published map: a number of mm, "
-        "'auto' (the default: the log's first contact when it approaches from free "
-        "space, else the rig's default) or 'none'; the controller keeps reading "
+        "'auto' (the default: the log's first contact from free space and its "
+        "final lift-off, a profile along x when both are plausible, else the one "
+        "that is, else the rig's default) or 'none'; the controller keeps reading "
         "the published map",
     )
     p.add_argument(

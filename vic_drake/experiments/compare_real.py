@@ -37,9 +37,11 @@ from vic_drake.experiments.surface_calibration import (
 )
 from vic_drake.realdata import read_bag
 from vic_drake.scenario import DisturbanceConfig
+from vic_drake.station.params import StationParams
 from vic_drake.tissue import TISSUE_LAWS
 from vic_drake.tissue.phantom import load_phantom
-from vic_drake.tissue.phantom.distorted import with_map_errors
+from vic_drake.tissue.phantom.distorted import with_map_errors, with_surface_profile
+from vic_drake.tissue.relaxation import tissue_relaxation
 
 
 def phantom_replay(bag: Path, real, phantom):
@@ -115,8 +117,13 @@ def compare_real(
         ``tissue_law`` the simulated tissue's law ("relaxing" unless
         ``tissue_law`` says "hc"). ``surface_offset_mm`` is the offset
         applied, ``surface_offset_source`` where it came from; the log's
-        evidence: ``surface_first_contact_mm`` (and its ``_sigma_mm``) and
-        ``controller_map_offset_mm`` (None when the log holds none).
+        evidence: ``surface_first_contact_mm`` (and its ``_sigma_mm``),
+        ``controller_map_offset_mm``, the lift-off's
+        ``surface_lift_off_mm`` (``_sigma_mm``, ``_kappa_scale``,
+        ``_speed_mm_per_s``) (None when the log holds none); with a profile
+        (source "first contact + lift-off") ``surface_profile_x_m`` and
+        ``surface_profile_offset_mm`` (its two anchors; ``surface_offset_mm``
+        is then their mean), else None.
         With ``return_frames``: (dict, sim DataFrame, real canonical DataFrame).
     """
     bag = Path(bag_dir)
@@ -147,9 +154,17 @@ def compare_real(
     )
     real = real_to_canonical(raw)
     published = load_phantom("measured", data_dir=data_dir, lookup="bilinear")
-    surface = surface_calibration(real, published, surface_offset)
-    # The simulated tissue: the published map raised by the offset.
-    phantom = with_map_errors(published, surface_offset_m=surface["offset_m"])
+    law = tissue_law if tissue_law is not None else StationParams().tissue_law
+    surface = surface_calibration(
+        real, published, surface_offset, relaxation=tissue_relaxation(law)
+    )
+    profile = surface["profile"]
+    # The simulated tissue: the published map raised by the offset (or the
+    # profile; the controller then reads the published map itself).
+    if profile is None:
+        phantom = with_map_errors(published, surface_offset_m=surface["offset_m"])
+    else:
+        phantom = with_surface_profile(published, profile["x_m"], profile["offset_m"])
     motion, table, surface_error = phantom_replay(bag, real, phantom)
     replay = bool(table)
     disturbance = DisturbanceConfig(table=table) if replay else None
@@ -182,15 +197,16 @@ def compare_real(
     )
     if tissue_law is not None:
         scenario.station.tissue_law = tissue_law
-    if surface["offset_m"] != 0.0:
+    if surface["offset_m"] != 0.0 and profile is None:
         # The controller reads the published map, as the real one read its own.
         scenario.variations.map_errors.surface_offset_m = -surface["offset_m"]
     if tissue_law is not None or surface["offset_m"] != 0.0:
         scenario.validate()
     if progress:
         progress(scenario.description)
+    extra = {} if profile is None else {"controller_phantom": published}
     result = run_scan(
-        scenario, phantom=phantom, duration_s=duration_s, progress=progress
+        scenario, phantom=phantom, duration_s=duration_s, progress=progress, **extra
     )
     lead = REAL_SCAN_FORCE_DELAY_S if raw.attrs["layout"] == "scan" else 0.0
     metrics = compare_with_real(result.df, real, force_lead_s=lead)
@@ -238,6 +254,8 @@ def compare_real(
     out.update(_surface_keys(surface))
     seen = real[real["t_s"] <= result.df["t_s"].iloc[-1] + metrics["time_offset_s"]]
     out.update(compare_contact_loss(result.df, seen))
+    # Added after the keys of earlier versions, whose order is kept.
+    out.update(_lift_off_keys(surface["lift_off"], surface["profile"]))
     if return_frames:
         return out, result.df, real
     return out
@@ -256,6 +274,24 @@ def _surface_keys(surface: dict) -> dict:
         else 1e3 * first.sigma_m,
         "controller_map_offset_mm": None if ctrl is None else 1e3 * ctrl,
     }
+
+
+def _lift_off_keys(lift, profile) -> dict:
+    """compare-real's lift-off and profile keys (mm; None where absent)."""
+    keys = ("mm", "sigma_mm", "kappa_scale", "speed_mm_per_s")
+    out = {f"surface_lift_off_{k}": None for k in keys}
+    if lift is not None:
+        out.update(
+            surface_lift_off_mm=1e3 * lift.offset_m,
+            surface_lift_off_sigma_mm=1e3 * lift.sigma_m,
+            surface_lift_off_kappa_scale=lift.kappa_scale,
+            surface_lift_off_speed_mm_per_s=1e3 * lift.speed_m_per_s,
+        )
+    out["surface_profile_x_m"] = None if profile is None else list(profile["x_m"])
+    out["surface_profile_offset_mm"] = (
+        None if profile is None else [1e3 * v for v in profile["offset_m"]]
+    )
+    return out
 
 
 __all__ = ["compare_real", "phantom_replay"]

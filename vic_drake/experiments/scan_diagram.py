@@ -125,12 +125,22 @@ class CommandedTipKinematics(LeafSystem):
         output.SetFromVector((p - last) / self._period_s)
 
 
-def MakeScanDiagram(scenario: Scenario, *, phantom=None, meshcat=None, data_dir=None):
+def MakeScanDiagram(
+    scenario: Scenario,
+    *,
+    phantom=None,
+    meshcat=None,
+    data_dir=None,
+    controller_phantom=None,
+):
     """Builds the closed-loop scan diagram of a scenario.
 
     Args:
         scenario: the run's configuration.
         phantom: the tissue (default: the scenario's phantom kind, loaded).
+        controller_phantom: the map the controller reads, before the
+            scenario's map errors (default: ``phantom``); compare-real's
+            surface profile raises the tissue and not the controller's map.
         meshcat: optional Meshcat for visualisation.
         data_dir: data folder for the measured map (default: vic_drake.paths).
 
@@ -165,7 +175,13 @@ def MakeScanDiagram(scenario: Scenario, *, phantom=None, meshcat=None, data_dir=
         "variable_impedance_controller",
         MakeVariableImpedanceController(
             scenario.controller,
-            phantom=controller_map(scenario, _controller_phantom(scenario, phantom)),
+            phantom=controller_map(
+                scenario,
+                _controller_phantom(
+                    scenario,
+                    phantom if controller_phantom is None else controller_phantom,
+                ),
+            ),
             stiffness_source=scenario.stiffness_source,
             estimator=scenario.online_estimator,
             online_surface=scenario.online_surface,

@@ -66,6 +66,7 @@ def run_scan(
     meshcat=None,
     progress=None,
     data_dir=None,
+    controller_phantom=None,
 ) -> ScanResult:
     """Simulates a scenario.
 
@@ -76,6 +77,8 @@ def run_scan(
         meshcat: optional Meshcat.
         progress: optional callable(str) receiving progress lines.
         data_dir: data folder for the measured map.
+        controller_phantom: the map the controller reads (default: the
+            tissue; see :func:`MakeScanDiagram`).
 
     Returns:
         ScanResult with the canonical DataFrame, wall time and real-time factor.
@@ -87,7 +90,11 @@ def run_scan(
     if phantom is None:
         phantom = load_scenario_phantom(scenario, data_dir=data_dir)
     diagram, loggers = MakeScanDiagram(
-        scenario, phantom=phantom, meshcat=meshcat, data_dir=data_dir
+        scenario,
+        phantom=phantom,
+        meshcat=meshcat,
+        data_dir=data_dir,
+        controller_phantom=controller_phantom,
     )
     simulator = Simulator(diagram)
     ApplySimulatorConfig(scenario.simulator, simulator)

@@ -1,15 +1,23 @@
 """The real phantom's surface against the published map: the rig's calibration.
 
-:func:`surface_calibration` decides the offset compare-real raises the
-simulated tissue by (the controller keeps reading the published map, as the
-real one read its own): a number given by the caller; "auto", the log's own
-first-contact estimate when the log approaches from free space
-(:func:`vic_drake.analysis.surface_offset.first_contact_offset`) and the
-estimate is plausible (within +-MAX_SURFACE_OFFSET_M, 1-sigma at most
-MAX_FIRST_CONTACT_SIGMA_M), else the
-rig's default :data:`vic_drake.realdata.RIG_SURFACE_OFFSET_M` (which
-:func:`rig_surface_offset` recomputes from the calibration logs); "none",
-no offset. compare-real's default is :data:`DEFAULT_SURFACE_OFFSET`.
+:func:`surface_calibration` decides how compare-real raises the simulated
+tissue (the controller keeps reading the published map, as the real one read
+its own): a number given by the caller; "none", no offset; "auto", from the
+log's own anchors outside the scored window, each used only when plausible
+(within +-MAX_SURFACE_OFFSET_M, 1-sigma at most MAX_FIRST_CONTACT_SIGMA_M;
+the lift-off also with a fit modulus within a factor MAX_LIFT_OFF_KAPPA_RATIO
+of the map's kappa):
+
+- the first contact from free space
+  (:func:`vic_drake.analysis.surface_offset.first_contact_offset`) and the
+  final lift-off (:func:`vic_drake.analysis.lift_off.lift_off_offset`), at
+  least MIN_PROFILE_SPAN_M apart in x: a profile linear in x between them,
+  held beyond (:func:`vic_drake.tissue.phantom.distorted.with_surface_profile`);
+- one of them: its offset, constant;
+- neither: the rig's default :data:`vic_drake.realdata.RIG_SURFACE_OFFSET_M`
+  (which :func:`rig_surface_offset` recomputes from the calibration logs).
+
+compare-real's default is :data:`DEFAULT_SURFACE_OFFSET`.
 """
 
 from __future__ import annotations
@@ -19,12 +27,14 @@ from pathlib import Path
 import numpy as np
 
 from vic_drake.analysis.columns import real_to_canonical
+from vic_drake.analysis.lift_off import lift_off_offset
 from vic_drake.analysis.surface_offset import (
     controller_map_offset,
     first_contact_offset,
 )
 from vic_drake.errors import VicDrakeError
 from vic_drake.realdata import RIG_SURFACE_OFFSET_M, read_bag
+from vic_drake.tissue.relaxation import DEFAULT_RELAXATION
 
 #: Largest offset accepted, m (the scenario's map errors allow +-0.02 m).
 MAX_SURFACE_OFFSET_M = 0.02
@@ -36,8 +46,22 @@ DEFAULT_SURFACE_OFFSET = "auto"
 #: Largest 1-sigma of a first-contact estimate that "auto" uses, m; a
 #: looser fit (a noisy or irregular approach) falls back on the rig default.
 MAX_FIRST_CONTACT_SIGMA_M = 0.0005
+#: Largest ratio (either way) between a lift-off fit's modulus and the map's
+#: kappa that "auto" uses: a lift that does not follow the tissue model the
+#: estimate corrects with is no evidence of the surface (docs/decisions.md,
+#: "Lift-off surface of the real logs").
+MAX_LIFT_OFF_KAPPA_RATIO = 1.5
+#: Shortest distance in x between the two anchors of a surface profile, m.
+MIN_PROFILE_SPAN_M = 0.02
 #: Where the offset came from (``surface_offset_source`` of compare-real).
-SURFACE_OFFSET_SOURCES = ("none", "given", "first contact", "rig default")
+SURFACE_OFFSET_SOURCES = (
+    "none",
+    "given",
+    "first contact",
+    "lift-off",
+    "first contact + lift-off",
+    "rig default",
+)
 
 
 def check_surface_offset(value, name: str = "surface_offset_m") -> float:
@@ -74,7 +98,9 @@ def parse_surface_offset(value):
     return check_surface_offset(value, "surface offset")
 
 
-def surface_calibration(real, phantom, offset=None) -> dict:
+def surface_calibration(
+    real, phantom, offset=None, *, relaxation=DEFAULT_RELAXATION
+) -> dict:
     """The surface offset for a real log's replay, and the evidence the log holds.
 
     Args:
@@ -82,26 +108,71 @@ def surface_calibration(real, phantom, offset=None) -> dict:
         phantom: the published map.
         offset: a number of m (used as given), "auto" or "none" (see the
             module doc); None for DEFAULT_SURFACE_OFFSET.
+        relaxation: the simulated tissue's relaxation (None: plain
+            Hunt-Crossley), which the lift-off estimate corrects for.
 
     Returns:
-        dict: ``offset_m`` (applied), ``source`` (one of
-        :data:`SURFACE_OFFSET_SOURCES`), ``first_contact`` (the
+        dict: ``offset_m`` (applied; with a profile, the mean of its two
+        anchors), ``source`` (one of :data:`SURFACE_OFFSET_SOURCES`),
+        ``profile`` (None, or ``{"x_m": [2], "offset_m": [2]}`` in increasing
+        x), ``first_contact`` (the
         :class:`~vic_drake.analysis.surface_offset.SurfaceOffset` of the log
-        or None) and ``controller_map_offset_m`` (or None).
+        or None), ``lift_off`` (the
+        :class:`~vic_drake.analysis.lift_off.LiftOff` or None) and
+        ``controller_map_offset_m`` (or None).
     """
     first = first_contact_offset(real, phantom)
+    lift = lift_off_offset(real, phantom, relaxation=relaxation)
     out = {
         "first_contact": first,
+        "lift_off": lift,
         "controller_map_offset_m": controller_map_offset(real, phantom),
+        "profile": None,
     }
     offset = parse_surface_offset(offset)
     if offset == "none":
         return {**out, "offset_m": 0.0, "source": "none"}
     if offset != "auto":
         return {**out, "offset_m": offset, "source": "given"}
-    if first is not None and _plausible(first):
+    use_first = first is not None and _plausible(first)
+    use_lift = lift is not None and _plausible_lift_off(lift)
+    if use_first and use_lift and abs(lift.x_m - first.x_m) >= MIN_PROFILE_SPAN_M:
+        profile = _profile(real, phantom, first, lift, relaxation)
+        if profile is not None:
+            return {
+                **out,
+                "lift_off": profile.pop("lift_off"),
+                "profile": profile,
+                "offset_m": float(np.mean(profile["offset_m"])),
+                "source": "first contact + lift-off",
+            }
+    if use_first:
         return {**out, "offset_m": first.offset_m, "source": "first contact"}
+    if use_lift:
+        return {**out, "offset_m": lift.offset_m, "source": "lift-off"}
     return {**out, "offset_m": RIG_SURFACE_OFFSET_M, "source": "rig default"}
+
+
+def _profile(real, phantom, first, lift, relaxation):
+    """The two-anchor profile, the lift-off re-read with the profile as its
+    relaxation history (two passes); None if the re-read is not plausible."""
+    for _ in range(2):
+        xs, offs = [first.x_m, lift.x_m], [first.offset_m, lift.offset_m]
+        order = np.argsort(xs)
+        xs, offs = list(np.asarray(xs)[order]), list(np.asarray(offs)[order])
+        history = np.interp(real["x_m"].to_numpy(float), xs, offs)
+        lift = lift_off_offset(
+            real, phantom, relaxation=relaxation, history_offset_m=history
+        )
+        if lift is None or not _plausible_lift_off(lift):
+            return None
+    xs, offs = [first.x_m, lift.x_m], [first.offset_m, lift.offset_m]
+    order = np.argsort(xs)
+    return {
+        "x_m": [float(xs[i]) for i in order],
+        "offset_m": [float(offs[i]) for i in order],
+        "lift_off": lift,
+    }
 
 
 def _plausible(first) -> bool:
@@ -109,6 +180,14 @@ def _plausible(first) -> bool:
     return (
         abs(first.offset_m) <= MAX_SURFACE_OFFSET_M
         and first.sigma_m <= MAX_FIRST_CONTACT_SIGMA_M
+    )
+
+
+def _plausible_lift_off(lift) -> bool:
+    """A lift-off estimate "auto" may use: as a first contact, and the lift
+    follows the tissue model (fit modulus near the map's kappa)."""
+    return _plausible(lift) and (
+        1.0 / MAX_LIFT_OFF_KAPPA_RATIO <= lift.kappa_scale <= MAX_LIFT_OFF_KAPPA_RATIO
     )
 
 
@@ -153,7 +232,9 @@ def rig_surface_offset(bags, phantom) -> dict:
 __all__ = [
     "DEFAULT_SURFACE_OFFSET",
     "MAX_FIRST_CONTACT_SIGMA_M",
+    "MAX_LIFT_OFF_KAPPA_RATIO",
     "MAX_SURFACE_OFFSET_M",
+    "MIN_PROFILE_SPAN_M",
     "SURFACE_OFFSET_MODES",
     "SURFACE_OFFSET_SOURCES",
     "check_surface_offset",

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from vic_drake.errors import VicDrakeError
 from vic_drake.tissue.phantom.base import Phantom, TissueSample
 from vic_drake.tissue.phantom.grid import GridPhantom
 
@@ -93,4 +94,47 @@ def with_map_errors(
     )
 
 
-__all__ = ["DistortedPhantom", "with_map_errors"]
+def with_surface_profile(phantom: Phantom, x_m, offsets_m) -> GridPhantom:
+    """A grid phantom whose surface is raised by a profile along x.
+
+    The offset is piecewise linear through the points (``x_m[i]``,
+    ``offsets_m[i]``) and held at the end values beyond them (a tissue
+    raised under a scan track by what its two ends measured); kappa, lambda
+    and the lookup are the phantom's, the slopes follow the raised surface.
+
+    Raises:
+        VicDrakeError: not a :class:`GridPhantom`, or the points are not
+            finite, of one length >= 2, and strictly increasing in x.
+    """
+    if not isinstance(phantom, GridPhantom):
+        raise VicDrakeError(
+            f"a surface profile needs a grid phantom; got {type(phantom).__name__}"
+        )
+    xs, offs = np.asarray(x_m, float), np.asarray(offsets_m, float)
+    if (
+        xs.ndim != 1
+        or xs.shape != offs.shape
+        or xs.size < 2
+        or not np.all(np.isfinite(xs))
+        or not np.all(np.isfinite(offs))
+        or np.any(np.diff(xs) <= 0)
+    ):
+        raise VicDrakeError(
+            "a surface profile needs finite points of one length >= 2, strictly "
+            f"increasing in x; got x_m={x_m!r}, offsets_m={offsets_m!r}"
+        )
+    raise_x = np.interp(phantom.x_m, xs, offs)
+    return GridPhantom(
+        x_m=phantom.x_m,
+        y_m=phantom.y_m,
+        z_m=phantom.surface_m - phantom.surface_offset_m + raise_x[:, None],
+        kappa=phantom.kappa_grid,
+        lam=phantom.lam_grid,
+        beta=phantom.beta,
+        surface_offset_m=phantom.surface_offset_m,
+        lookup=phantom.lookup,
+        name=f"{phantom.name} (surface profile)",
+    )
+
+
+__all__ = ["DistortedPhantom", "with_map_errors", "with_surface_profile"]
