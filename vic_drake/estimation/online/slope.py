@@ -27,9 +27,14 @@ the height on the newest data. A solve is valid once the contact has
 lasted ``2 slope_memory_s``, the tip's motion beyond the trend has an RMS
 of at least ``slope_min_motion_m``, k's relative standard error (from the
 fit's residuals) is at most ``slope_max_rel_std``, k > 0 and
-0 < eps < :data:`MAX_PENETRATION_M`. Its surface ``mean z + eps`` holds at
-the weighted mean time of the data; the output surface tracks it (brought
-to now with the tracked rate) through a second-order filter (see
+0 < eps < :data:`MAX_PENETRATION_M`. A solve that is not valid says nothing
+about how a change of the force splits between kappa and the depth; it
+keeps kappa = F / eps^beta of the last valid solve and reads the depth from
+its own mean force, eps = (F / kappa)^(1 / beta) (where the stiffness
+saturates or the force sits at its bound the tip stops moving, while the
+force still follows the depth). Its surface ``mean z + eps`` holds at the
+weighted mean time of the data; the output surface tracks it (brought to
+now with the tracked rate) through a second-order filter (see
 :func:`slope_step`). Everything restarts at each loss of contact.
 """
 
@@ -72,7 +77,8 @@ _Z_MEAN = _EPS + 1  # mean tip height of the last solve's data, m
 _T_MEAN = _Z_MEAN + 1  # its weighted mean time, s
 _S_OUT = _T_MEAN + 1  # the tracked surface, m (NaN: none)
 _V_OUT = _S_OUT + 1  # its rate, m/s
-SLOPE_SIZE = _V_OUT + 1
+_KAPPA = _V_OUT + 1  # F / eps^beta of the last valid solve (NaN: none)
+SLOPE_SIZE = _KAPPA + 1
 
 
 class SlopeEstimate(NamedTuple):
@@ -81,8 +87,8 @@ class SlopeEstimate(NamedTuple):
     Attributes:
         surface_z_m: the tracked surface height (NaN before the first
             valid solve since contact), m.
-        penetration_m: eps of the last valid solve (NaN before the first
-            since contact), m.
+        penetration_m: eps of the last valid solve, or from its kappa and
+            the force after it (NaN before the first since contact), m.
         slope_N_per_m: k of the last solve (NaN before one).
         slope_rel_std: its relative standard error (NaN before one).
         motion_m: RMS of the tip's motion beyond the trend in the last
@@ -102,7 +108,8 @@ def slope_initial_state() -> list[float]:
     """A fresh fit: no sample, no estimate."""
     state = [0.0] * SLOPE_SIZE
     for i in (
-        _T_REF, _T_START, _T_LAST, _SLOPE, _REL_STD, _EPS, _Z_MEAN, _T_MEAN, _S_OUT
+        _T_REF, _T_START, _T_LAST, _SLOPE, _REL_STD, _EPS, _Z_MEAN, _T_MEAN, _S_OUT,
+        _KAPPA,
     ):  # fmt: skip
         state[i] = math.nan
     return state
@@ -153,7 +160,8 @@ def _solve(s: list[float], t: float, p: OnlineEstimatorParams) -> None:
     s[_SLOPE] = slope
     s[_REL_STD] = math.sqrt(max(var_k, 0.0)) / abs(slope) if slope != 0.0 else math.inf
     s[_MOTION] = math.sqrt(max(float(motion2), 0.0))
-    eps = p.beta * float(b[0]) / w0 / slope if slope > 0.0 else math.nan
+    force = float(b[0]) / w0  # the data's weighted mean force
+    eps = p.beta * force / slope if slope > 0.0 else math.nan
     ok = (
         t - s[_T_START] >= 2.0 * p.slope_memory_s
         and s[_MOTION] >= p.slope_min_motion_m
@@ -163,6 +171,9 @@ def _solve(s: list[float], t: float, p: OnlineEstimatorParams) -> None:
     if ok:
         s[_VALID] = 1.0
         s[_EPS] = eps
+        s[_KAPPA] = force / eps**p.beta
+    elif force > 0.0 and math.isfinite(s[_KAPPA]):  # Not valid: kappa held.
+        s[_EPS] = (force / s[_KAPPA]) ** (1.0 / p.beta)
 
 
 def slope_step(
@@ -177,13 +188,12 @@ def slope_step(
     """One sample of the fit and of the surface it measures.
 
     The output surface tracks ``m = mean z + eps + v (t - mean time)`` (the
-    last solve's mean tip height, eps of the last valid solve, held while
-    the solves are not valid: where the force is capped or the stiffness
-    saturates the tip stops moving, and the probe, pressing with a steady
-    force, keeps its penetration; v the tracked rate) through a filter of
-    natural frequency w = 1 / ``slope_surface_time_s`` that follows a ramp
-    without lag (``s' = v + 2 w e``, ``v' = w^2 e``, e = m - s clipped at
-    :data:`MAX_SURFACE_ERROR_M`). It is slower than the probe's own motion
+    last solve's mean tip height; eps of the last valid solve, or, while
+    the solves are not valid, the depth at which the last solve's mean
+    force meets the last valid solve's kappa; v the tracked rate) through
+    a filter of natural frequency w = 1 / ``slope_surface_time_s`` that
+    follows a ramp without lag (``s' = v + 2 w e``, ``v' = w^2 e``,
+    e = m - s clipped at :data:`MAX_SURFACE_ERROR_M`). It is slower than the probe's own motion
     on purpose: within that time the surface stays put under a probe that
     presses deeper (a surface that followed the tip at once would read
     every change of force as a change of kappa). It starts at
