@@ -13,7 +13,7 @@ that both see the same machine load, over
   unknown (NaN), so that the EKF runs on the slope fit's surface.
 
 Prints per log and function the median and p99 wall time of a tick (best
-of three runs for each percentile) and the largest relative difference of
+of three runs for each percentile; ``--cpu``: the thread's CPU time) and the largest relative difference of
 every output between the two checkouts (over samples where both are
 finite; a differing NaN pattern is reported). The issue's budget is 30 us
 p99 per tick.
@@ -90,13 +90,12 @@ def _inputs():
     return logs
 
 
-def _run(pair, rows):
-    """Per-tick wall times (2, n) and outputs (2, n, k) of the two steps."""
+def _run(pair, rows, clock=time.perf_counter):
+    """Per-tick times (2, n), us, and outputs (2, n, k) of the two steps."""
     (step_a, state_a), (step_b, state_b) = pair
     n = len(rows)
     ticks = np.empty((2, n))
     out_a, out_b = [], []
-    clock = time.perf_counter
     for k, row in enumerate(rows):
         if k % 2:
             t0 = clock()
@@ -136,6 +135,13 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--baseline", metavar="DIR", required=True)
     parser.add_argument("--runs", type=int, default=3, help="runs per log (best of)")
+    parser.add_argument(
+        "--cpu",
+        action="store_true",
+        help="time ticks with this thread's CPU time instead of the wall clock "
+        "(leaves out the time the process waits for a core on a loaded machine; "
+        "each reading costs about a microsecond)",
+    )
     args = parser.parse_args()
     if not is_checkout(args.baseline):
         parser.error(f"--baseline {args.baseline!r} holds no vic_drake package")
@@ -143,6 +149,7 @@ def main() -> int:
         parser.error(f"--runs must be >= 1; got {args.runs}")
     print(versions())
     print(f"this checkout {HERE} against the baseline {args.baseline}")
+    print("tick times: " + ("thread CPU time" if args.cpu else "wall clock"))
     new = _load(HERE)
     old = _load(args.baseline)
     kwargs = dict(method="ekf", surface_from_slope=True, surface_walk_m_per_sqrt_s=0.0)
@@ -170,7 +177,8 @@ def main() -> int:
                             slope.slope_initial_state(),
                         )
                     )
-            results = [_run(pair, rows) for _ in range(args.runs)]
+            clock = time.thread_time if args.cpu else time.perf_counter
+            results = [_run(pair, rows, clock) for _ in range(args.runs)]
             p50 = np.min([np.median(r[0], axis=1) for r in results], axis=0)
             p99 = np.min([np.percentile(r[0], 99, axis=1) for r in results], axis=0)
             fields = OUTPUT_FIELDS if what == "ekf_slope_step" else slope_fields
