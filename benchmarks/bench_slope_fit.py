@@ -90,6 +90,19 @@ def _inputs():
     return logs
 
 
+def _step(modules, what: str):
+    """(step(state, row) -> (state, outputs), initial state) of one checkout."""
+    ekf, slope, params_cls = modules
+    p = params_cls(method="ekf", surface_from_slope=True, surface_walk_m_per_sqrt_s=0.0)
+    if what == "ekf_slope_step":
+        step = ekf.ekf_slope_step
+        return (lambda s, row: step(s, *row, math.nan, p)), ekf.ekf_slope_initial_state(
+            p
+        )
+    step = slope.slope_step
+    return (lambda s, row: step(s, *row, p)), slope.slope_initial_state()
+
+
 def _run(pair, rows, clock=time.perf_counter):
     """Per-tick times (2, n), us, and outputs (2, n, k) of the two steps."""
     (step_a, state_a), (step_b, state_b) = pair
@@ -152,31 +165,13 @@ def main() -> int:
     print("tick times: " + ("thread CPU time" if args.cpu else "wall clock"))
     new = _load(HERE)
     old = _load(args.baseline)
-    kwargs = dict(method="ekf", surface_from_slope=True, surface_walk_m_per_sqrt_s=0.0)
-    nan = math.nan
     from vic_drake.estimation.online.core import OUTPUT_FIELDS
 
     slope_fields = old[1].SlopeEstimate._fields
     for log, (t, z, v, f) in _inputs().items():
         rows = list(zip(t.tolist(), z.tolist(), v.tolist(), f.tolist()))
         for what in ("ekf_slope_step", "slope_step"):
-            pair = []
-            for ekf, slope, params_cls in (old, new):
-                p = params_cls(**kwargs)
-                if what == "ekf_slope_step":
-                    pair.append(
-                        (
-                            lambda s, r, f=ekf.ekf_slope_step, p=p: f(s, *r, nan, p),
-                            ekf.ekf_slope_initial_state(p),
-                        )
-                    )
-                else:
-                    pair.append(
-                        (
-                            lambda s, r, f=slope.slope_step, p=p: f(s, *r, p),
-                            slope.slope_initial_state(),
-                        )
-                    )
+            pair = [_step(modules, what) for modules in (old, new)]
             clock = time.thread_time if args.cpu else time.perf_counter
             results = [_run(pair, rows, clock) for _ in range(args.runs)]
             p50 = np.min([np.median(r[0], axis=1) for r in results], axis=0)
