@@ -133,6 +133,19 @@ def replay_online(
     """
     params = OnlineEstimatorParams() if params is None else params
     params.validate()
+    kind, inputs, kappa_ref, lam_ref, lag = replay_inputs(bag, params, lag_s)
+    trace = run_online(*inputs, params)
+    return score_online(kind, trace, kappa_ref, lam_ref, lag, params)
+
+
+def replay_inputs(bag, params: OnlineEstimatorParams, lag_s: float | None = None):
+    """What :func:`replay_online` feeds the estimator, and its reference.
+
+    Returns:
+        (kind, (t, z, z_dot, force, surface) as :func:`run_online` takes
+        them, with z, z_dot and the surface delayed by the lag; kappa_ref,
+        lam_ref, lag_s). ``params`` gives the palpation reference's beta.
+    """
     if lag_s is not None and not (np.isfinite(lag_s) and 0.0 <= lag_s <= 1.0):
         raise VicDrakeError(f"lag_s must be in [0, 1] s; got {lag_s!r}")
     df = read_bag(bag)
@@ -154,10 +167,8 @@ def replay_online(
     t, z, vz, force, surface = inputs
     period = float(np.median(np.diff(t)))
     d = int(round(lag / period)) if period > 0 else 0
-    trace = run_online(
-        t, _delay(z, d), _delay(vz, d), force, _delay(surface, d), params
-    )
-    return score_online(kind, trace, kappa_ref, lam_ref, lag, params)
+    inputs = (t, _delay(z, d), _delay(vz, d), force, _delay(surface, d))
+    return kind, inputs, kappa_ref, lam_ref, lag
 
 
 def score_online(kind, trace, kappa_ref, lam_ref, lag, params) -> OnlineReplay:
@@ -189,4 +200,10 @@ def score_online(kind, trace, kappa_ref, lam_ref, lag, params) -> OnlineReplay:
     return OnlineReplay(kind, trace, kappa_ref, lam_ref, lag, summary, float(final))
 
 
-__all__ = ["REPLAY_LAYOUTS", "OnlineReplay", "replay_online", "score_online"]
+__all__ = [
+    "REPLAY_LAYOUTS",
+    "OnlineReplay",
+    "replay_inputs",
+    "replay_online",
+    "score_online",
+]

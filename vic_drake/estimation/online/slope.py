@@ -21,21 +21,24 @@ frequency). The fit takes z as the penetration's motion: it does not model
 the surface under the tip moving with the tip's sideways sway (friction
 follows the force, so that sway cannot be a regressor).
 
-The sums are accumulated every sample (pure Python floats); the 6 x 6
-solve runs every :data:`SOLVE_EVERY` samples, after re-centring time and
-the height on the newest data. A solve is valid once the contact has
-lasted ``2 slope_memory_s``, the tip's motion beyond the trend has an RMS
-of at least ``slope_min_motion_m``, k's relative standard error (from the
-fit's residuals) is at most ``slope_max_rel_std``, k > 0 and
-0 < eps < :data:`MAX_PENETRATION_M`. A solve that is not valid says nothing
-about how a change of the force splits between kappa and the depth; it
-keeps kappa = F / eps^beta of the last valid solve and reads the depth from
-its own mean force, eps = (F / kappa)^(1 / beta) (where the stiffness
-saturates or the force sits at its bound the tip stops moving, while the
-force still follows the depth). Its surface ``mean z + eps`` holds at the
-weighted mean time of the data; the output surface tracks it (brought to
-now with the tracked rate) through a second-order filter (see
-:func:`slope_step`). Everything restarts at each loss of contact.
+The sums are accumulated every sample; every :data:`SOLVE_EVERY` samples
+they are re-centred (time and height on the newest data) and the 6 x 6
+normal equations solved by Cholesky
+(:mod:`vic_drake.estimation.online.slope_gram`, pure Python floats); a
+Gram matrix that is not numerically positive definite gives no solve. A
+solve is valid once the contact has lasted ``2 slope_memory_s``, the tip's
+motion beyond the trend has an RMS of at least ``slope_min_motion_m``, k's
+relative standard error (from the fit's residuals) is at most
+``slope_max_rel_std``, k > 0 and 0 < eps < :data:`MAX_PENETRATION_M`. A
+solve that is not valid says nothing about how a change of the force
+splits between kappa and the depth; it keeps kappa = F / eps^beta of the
+last valid solve and reads the depth from its own mean force,
+eps = (F / kappa)^(1 / beta) (where the stiffness saturates or the force
+sits at its bound the tip stops moving, while the force still follows the
+depth). Its surface ``mean z + eps`` holds at the weighted mean time of
+the data; the output surface tracks it (brought to now with the tracked
+rate) through a second-order filter (see :func:`slope_step`). Everything
+restarts at each loss of contact.
 """
 
 from __future__ import annotations
@@ -43,9 +46,13 @@ from __future__ import annotations
 import math
 from typing import NamedTuple
 
-import numpy as np
-
 from vic_drake.estimation.online.params import OnlineEstimatorParams
+from vic_drake.estimation.online.slope_gram import (
+    SUMS_SIZE,
+    add_sample,
+    shift_basis,
+    solve_sums,
+)
 
 #: Samples between two solves of the fit.
 SOLVE_EVERY = 10
@@ -54,10 +61,7 @@ MAX_PENETRATION_M = 0.05
 #: The surface filter's error is clipped at this, m: a bad solve moves the
 #: surface at a bounded rate.
 MAX_SURFACE_ERROR_M = 1e-3
-_DEGREE = 3  # of the trend in time
-_N = _DEGREE + 3  # 1, tau, tau^2, tau^3, -(z - z0), -z_dot
-_Z = _DEGREE + 1  # the column of -(z - z0)
-_PAIRS = [(i, j) for i in range(_N) for j in range(i, _N)]
+_Z = 4  # the column of z0 - z in the fit's functions (slope_gram)
 
 # State layout.
 _T_REF = 0  # time the basis is centred on (NaN: no sample since the reset)
@@ -65,9 +69,9 @@ _Z_REF = 1
 _T_START = 2  # first contact sample since the reset
 _T_LAST = 3  # last good sample
 _COUNT = 4  # samples since the last solve
-_G = 5  # the upper triangle of the Gram matrix
-_B = _G + len(_PAIRS)  # its right-hand side (the force)
-_FF = _B + _N  # the weighted sum of the squared forces
+_G = 5  # the sums of slope_gram: the upper triangle of the Gram matrix,
+_B = _G + 21  # its right-hand side (the force),
+_FF = _G + SUMS_SIZE - 1  # the weighted sum of the squared forces
 _SLOPE = _FF + 1  # k of the last solve, N/m (NaN: none)
 _REL_STD = _SLOPE + 1  # its relative standard error
 _MOTION = _REL_STD + 1  # RMS of the tip's motion beyond the trend, m
@@ -117,50 +121,28 @@ def slope_initial_state() -> list[float]:
 
 def _solve(s: list[float], t: float, p: OnlineEstimatorParams) -> None:
     """Re-centres the sums on t and the mean heights, then solves (in place)."""
-    G = np.zeros((_N, _N))
-    for k, (i, j) in enumerate(_PAIRS):
-        G[i, j] = G[j, i] = s[_G + k]
-    b = np.array(s[_B : _B + _N])
-    w0 = G[0, 0]
     d = t - s[_T_REF]
-    dz = -G[0, _Z] / w0  # mean z - z0
-    # tau_new = tau_old - d: (tau - d)^i = sum_j C(i, j) (-d)^(i - j) tau^j.
-    A = np.eye(_N)
-    for i in range(1, _DEGREE + 1):
-        for j in range(i):
-            A[i, j] = math.comb(i, j) * (-d) ** (i - j)
-    A[_Z, 0] = dz
-    scale = math.exp(-d / p.slope_memory_s)
-    G = scale * (A @ G @ A.T)
-    b = scale * (A @ b)
-    s[_FF] *= scale
-    for k, (i, j) in enumerate(_PAIRS):
-        s[_G + k] = float(G[i, j])
-    s[_B : _B + _N] = b.tolist()
+    dz = -s[_G + _Z] / s[_G]  # mean z - z0 (G04 / G00 = mean of z0 - z)
+    sums = shift_basis(s[_G : _FF + 1], d, dz, math.exp(-d / p.slope_memory_s))
+    s[_G : _FF + 1] = sums
     s[_T_REF] = t
     s[_Z_REF] += dz
     s[_COUNT] = 0.0
-    w0 = G[0, 0]
+    w0 = sums[0]
     s[_Z_MEAN] = s[_Z_REF]
-    s[_T_MEAN] = t + G[0, 1] / w0
+    s[_T_MEAN] = t + sums[1] / w0
     s[_VALID] = 0.0
-    unit_z = np.zeros(_N)
-    unit_z[_Z] = 1.0
-    try:
-        trend = np.linalg.solve(G[:_Z, :_Z], G[:_Z, _Z])
-        coef, g_inv_z = np.linalg.solve(G, np.column_stack([b, unit_z])).T
-    except np.linalg.LinAlgError:
+    fit = solve_sums(sums)
+    if fit is None:  # G not positive definite: no solve, as a singular one.
         return
-    motion2 = (G[_Z, _Z] - G[_Z, :_Z] @ trend) / w0
-    slope = float(coef[_Z])
+    schur_z, slope, residual, g_inv_z = fit
     # Weighted mean squared residual, and the variance of k: sigma^2 G^-1
     # scaled by sum w^2 / sum w, which is 1/2 for exponential weights.
-    residual2 = max(s[_FF] - float(coef @ b), 0.0) / w0
-    var_k = residual2 * float(g_inv_z[_Z]) * 0.5
+    var_k = max(residual, 0.0) / w0 * g_inv_z * 0.5
     s[_SLOPE] = slope
-    s[_REL_STD] = math.sqrt(max(var_k, 0.0)) / abs(slope) if slope != 0.0 else math.inf
-    s[_MOTION] = math.sqrt(max(float(motion2), 0.0))
-    force = float(b[0]) / w0  # the data's weighted mean force
+    s[_REL_STD] = math.sqrt(var_k) / abs(slope) if slope != 0.0 else math.inf
+    s[_MOTION] = math.sqrt(schur_z / w0)
+    force = sums[_B - _G] / w0  # the data's weighted mean force
     eps = p.beta * force / slope if slope > 0.0 else math.nan
     ok = (
         t - s[_T_START] >= 2.0 * p.slope_memory_s
@@ -230,18 +212,7 @@ def slope_step(
         s[_Z_REF] = z
     tau = t - s[_T_REF]
     w = math.exp(tau / p.slope_memory_s)
-    tau2 = tau * tau
-    phi = (1.0, tau, tau2, tau2 * tau, s[_Z_REF] - z, -z_dot)
-    k = _G
-    for i in range(_N):
-        wi = w * phi[i]
-        for j in range(i, _N):
-            s[k] += wi * phi[j]
-            k += 1
-    wf = w * force
-    for i in range(_N):
-        s[_B + i] += wf * phi[i]
-    s[_FF] += wf * force
+    s[_G : _FF + 1] = add_sample(s[_G : _FF + 1], w, tau, s[_Z_REF] - z, -z_dot, force)
     s[_COUNT] += 1.0
     if s[_COUNT] >= SOLVE_EVERY:
         _solve(s, t, p)
