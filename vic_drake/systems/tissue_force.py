@@ -347,9 +347,9 @@ class TissueForceElement(LeafSystem):
              p_WT, v_WT, p_WPh, v_WPh)
         )  # fmt: skip
 
-    def _store(self, context, discrete_state, terms, tick: float) -> None:
+    def _store(self, discrete_state, cached, terms, tick: float) -> None:
         """Stores the sample of the cached kinematics with ``terms``, for ``tick``."""
-        _, _, _, _, _, p_WT, v_WT, p_WPh, _ = self._contact_cache.Eval(context)
+        p_WT, v_WT, p_WPh = cached[5], cached[6], cached[7]
         force, eps, eps_dot, surface, kappa, lam = terms[:6]
         discrete_state.set_value(
             self._sample,
@@ -358,15 +358,15 @@ class TissueForceElement(LeafSystem):
                 p_WT[0] - p_WPh[0], p_WT[1] - p_WPh[1], p_WT[2] - p_WPh[2],
             ]),
         )  # fmt: skip
-        discrete_state.set_value(self._sample_tick, np.array([tick]))
+        discrete_state.get_mutable_value(self._sample_tick)[0] = tick
 
     def _tick(self, context) -> float:
         return float(round(context.get_time() / self._period))
 
     def _initialize(self, context, discrete_state):
         # The cached terms are those of this context's branch states.
-        terms = self._contact_cache.Eval(context)[3]
-        self._store(context, discrete_state, terms, self._tick(context))
+        cached = self._contact_cache.Eval(context)
+        self._store(discrete_state, cached, cached[3], self._tick(context))
 
     def _update(self, context, discrete_state):
         cached = self._contact_cache.Eval(context)
@@ -374,7 +374,9 @@ class TissueForceElement(LeafSystem):
         if self._branches is not None:
             eps = terms[1]
             u = (eps if eps > 0.0 else 0.0) ** self._beta  # relaxation_input
-            s = context.get_discrete_state(self._branches).value().tolist()
+            # discrete_state holds the current state on entry (a LeafSystem
+            # copies it in before calling an update handler).
+            s = discrete_state.value(self._branches).tolist()
             # relaxation_step: u + (s - u) exp(-dt / tau), per branch.
             s = [u + (s_i - u) * d for s_i, d in zip(s, self._decay, strict=True)]
             discrete_state.set_value(self._branches, np.array(s))
@@ -384,12 +386,12 @@ class TissueForceElement(LeafSystem):
                 sample, self._beta, p_WT, v_WT, p_WPh, v_WPh, *self._settings,
                 self._weighted(s),
             )  # fmt: skip
-        self._store(context, discrete_state, terms, self._tick(context) + 1.0)
+        self._store(discrete_state, cached, terms, self._tick(context) + 1.0)
 
     def _calc_spatial_forces(self, context, output):
-        tick = context.get_discrete_state(self._sample_tick).value()[0]
-        if tick == self._tick(context):
-            sample = context.get_discrete_state(self._sample).value()
+        state = context.get_discrete_state()  # one crossing for both groups
+        if state.value(self._sample_tick)[0] == self._tick(context):
+            sample = state.value(self._sample)
             f_W, p_PhT = sample[6:9], sample[14:17]
         else:  # No tick stored for this time: from the inputs.
             _, _, f_W, _, _, p_WT, _, p_WPh, _ = self._contact_cache.Eval(context)
