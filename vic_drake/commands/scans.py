@@ -35,6 +35,25 @@ def _positive(value: str, option: str) -> float:
     return v
 
 
+def _count(value: str) -> int:
+    """--lateral-passes: an integer from 0 to MAX_LATERAL_PASSES."""
+    from vic_drake.experiments.lateral_replay import MAX_LATERAL_PASSES
+
+    try:
+        n = int(value)
+    except ValueError:
+        raise VicDrakeError(
+            f"--lateral-passes takes an integer from 0 to {MAX_LATERAL_PASSES}; "
+            f"got {value!r}"
+        ) from None
+    if not 0 <= n <= MAX_LATERAL_PASSES:
+        raise VicDrakeError(
+            f"--lateral-passes takes an integer from 0 to {MAX_LATERAL_PASSES}; "
+            f"got {value!r}"
+        )
+    return n
+
+
 def _surface_offset(value: str):
     """--surface-offset: "auto", "none" or a number of mm (returned in m)."""
     from vic_drake.experiments.surface_calibration import (
@@ -127,6 +146,14 @@ def register(subparsers) -> None:
         "the published map",
     )
     p.add_argument(
+        "--lateral-passes",
+        metavar="N",
+        default=None,
+        help="rerun the scan N times (0-3, default 0), each with the target moved "
+        "by the previous run's lateral error against the real tip, so the "
+        "simulated tip crosses the map where the real one did",
+    )
+    p.add_argument(
         "--plot", metavar="PNG", default=None, help="save a sim-vs-real figure"
     )
     p.add_argument(
@@ -188,6 +215,7 @@ def run_compare_real(args: argparse.Namespace) -> int:
     offset = (
         None if args.surface_offset is None else _surface_offset(args.surface_offset)
     )
+    passes = 0 if args.lateral_passes is None else _count(args.lateral_passes)
     # Output paths are checked before simulating: a bad one fails now.
     if args.out:
         check_output_file(args.out, "--out", LOG_SUFFIXES)
@@ -204,6 +232,7 @@ def run_compare_real(args: argparse.Namespace) -> int:
         duration_s=duration,
         tissue_law=args.tissue_law,
         surface_offset=offset,
+        lateral_passes=passes,
         progress=progress,
         return_frames=True,
     )

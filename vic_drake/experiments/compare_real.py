@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from vic_drake.analysis.columns import real_to_canonical
+from vic_drake.analysis.contact import scan_window
 from vic_drake.analysis.identification import estimate_force_loop_gain
 from vic_drake.analysis.phantom_motion import (
     estimate_phantom_motion,
@@ -24,6 +25,11 @@ from vic_drake.analysis.phantom_motion import (
 )
 from vic_drake.analysis.real_comparison import compare_contact_loss, compare_with_real
 from vic_drake.errors import VicDrakeError
+from vic_drake.experiments.lateral_replay import (
+    check_lateral_passes,
+    corrected_waypoints,
+    lateral_rms_mm,
+)
 from vic_drake.experiments.real_logs import (
     REAL_SCAN_FORCE_DELAY_S,
     identify_real_log,
@@ -36,7 +42,7 @@ from vic_drake.experiments.surface_calibration import (
     surface_calibration,
 )
 from vic_drake.realdata import read_bag
-from vic_drake.scenario import DisturbanceConfig
+from vic_drake.scenario import DisturbanceConfig, TrajectoryConfig
 from vic_drake.station.params import StationParams
 from vic_drake.tissue import TISSUE_LAWS
 from vic_drake.tissue.phantom import load_phantom
@@ -83,6 +89,7 @@ def compare_real(
     duration_s: float | None = None,
     tissue_law: str | None = None,
     surface_offset: float | str | None = None,
+    lateral_passes: int = 0,
     progress=None,
     return_frames: bool = False,
 ):
@@ -103,6 +110,12 @@ def compare_real(
     :data:`~vic_drake.experiments.surface_calibration.DEFAULT_SURFACE_OFFSET`
     (:func:`~vic_drake.experiments.surface_calibration.surface_calibration`);
     the controller keeps reading the published map.
+    ``lateral_passes`` (0 to 3, default 0: one run, as before) reruns the
+    scan that many times, each with the target moved by the previous run's
+    lateral error against the real tip
+    (:func:`~vic_drake.experiments.lateral_replay.corrected_waypoints`), so the
+    simulated tip crosses the map where the real one did; the metrics are
+    those of the last run.
 
     Returns:
         dict with the contract keys controller, duration_s, force_rmse_N,
@@ -123,7 +136,9 @@ def compare_real(
         ``_speed_mm_per_s``) (None when the log holds none); with a profile
         (source "first contact + lift-off") ``surface_profile_x_m`` and
         ``surface_profile_offset_mm`` (its two anchors; ``surface_offset_mm``
-        is then their mean), else None.
+        is then their mean), else None. ``lateral_passes`` and
+        ``lateral_rms_mm`` (per run, the RMS horizontal distance between the
+        tips over the real scan window) are appended.
         With ``return_frames``: (dict, sim DataFrame, real canonical DataFrame).
     """
     bag = Path(bag_dir)
@@ -143,6 +158,7 @@ def compare_real(
             f"tissue_law must be one of {list(TISSUE_LAWS)}; got {tissue_law!r}"
         )
     surface_offset = parse_surface_offset(surface_offset)
+    lateral_passes = check_lateral_passes(lateral_passes)
     # The controller first: a log whose signals cannot tell fails before the
     # motion estimate and the simulation.
     identification = identify_real_log(
@@ -208,6 +224,19 @@ def compare_real(
     result = run_scan(
         scenario, phantom=phantom, duration_s=duration_s, progress=progress, **extra
     )
+    window = scan_window(real)
+    lateral_rms = [lateral_rms_mm(result.df, real, window)]
+    for _ in range(lateral_passes):
+        start_z = scenario.trajectory.initial_tip_z_m
+        if start_z is None:
+            start_z = scenario.trajectory.approach_z_m
+        scenario.trajectory = TrajectoryConfig(
+            waypoints=corrected_waypoints(result.df, real), initial_tip_z_m=start_z
+        )
+        result = run_scan(
+            scenario, phantom=phantom, duration_s=duration_s, progress=progress, **extra
+        )
+        lateral_rms.append(lateral_rms_mm(result.df, real, window))
     lead = REAL_SCAN_FORCE_DELAY_S if raw.attrs["layout"] == "scan" else 0.0
     metrics = compare_with_real(result.df, real, force_lead_s=lead)
     unaligned = compare_with_real(result.df, real, force_lead_s=lead, align=False)
@@ -256,6 +285,8 @@ def compare_real(
     out.update(compare_contact_loss(result.df, seen))
     # Added after the keys of earlier versions, whose order is kept.
     out.update(_lift_off_keys(surface["lift_off"], surface["profile"]))
+    out["lateral_passes"] = lateral_passes
+    out["lateral_rms_mm"] = lateral_rms
     if return_frames:
         return out, result.df, real
     return out
