@@ -8,6 +8,7 @@ from tests.control.stiffness_qp.cases import problem, random_problems
 from vic_drake.control.params import StiffnessQpParams
 from vic_drake.control.stiffness_qp.exact import solve_stiffness_qp_exact
 from vic_drake.control.stiffness_qp.problem import (
+    StiffnessQpProblem,
     stiffness_qp_cost,
     stiffness_qp_violation,
 )
@@ -90,3 +91,30 @@ def test_every_drake_solver_runs_the_program(solver):
         assert np.allclose(
             sol.stiffness, solve_stiffness_qp_exact(p).stiffness, atol=tol, rtol=0
         )
+
+
+def test_a_force_row_out_of_reach_of_an_underflowing_error_is_infeasible(osqp):
+    # Found by the oracle test: e_z ~ 1e-309 cannot make the z force reach
+    # F_min - D e_dot = 0.40 N with any K of the box. The exact solver divided
+    # by it (-inf) and called K_min optimal; the program got bounds beyond
+    # OSQP's infinity and failed in its setup.
+    p = StiffnessQpProblem(
+        e=(0.0, 0.0, -2.225073858507203e-309),
+        e_dot=(0.0, 0.0, -0.046875),
+        damping=(24.491198419023927, 24.491198419023927, 29.895317559778487),
+        force_ref=(0.0, 0.0, -0.0),
+        force_min=(-15.0, -15.0, -1.0),
+        force_max=(15.0, 15.0, 15.0),
+        stiffness_min=(300.0, 300.0, 100.0),
+        stiffness_max=(1000.0, 1000.0, 1000.0),
+        q_weight=(3200.0, 3200.0, 3200.0),
+        r_weight=(1e-05, 1e-05, 1e-05),
+        tank_a=(0.0, 0.0, 1.04300337117524e-310),
+        tank_lb_energy=-153.6,
+        tank_lb_power=-0.1,
+    )
+    exact = solve_stiffness_qp_exact(p)
+    mp = osqp.solve(p)
+    assert not exact.success and not mp.success
+    assert exact.stiffness == mp.stiffness == p.stiffness_min
+    assert mp.status == "infeasible"

@@ -26,10 +26,12 @@ from vic_drake.control.stiffness_qp.problem import (
 )
 
 _INF = float("inf")
+#: Tolerance on the per-axis interval and the tank rows (relative, floor 1).
+FEASIBILITY_TOL = 1e-9
 
 
 def solve_stiffness_qp_exact(
-    problem: StiffnessQpProblem, *, feas_tol: float = 1e-9
+    problem: StiffnessQpProblem, *, feas_tol: float = FEASIBILITY_TOL
 ) -> StiffnessQpSolution:
     """Exact solution of the stiffness QP (closed form on the KKT conditions).
 
@@ -173,7 +175,9 @@ def _axis(ei, edi, di, fri, fmin, fmax, kmin, kmax, q, r, bit, feas_tol):
     ):
         return None
     if lo > hi:
-        if lo - hi > feas_tol * max(1.0, abs(hi)):
+        # hi = -inf: the force row divided by an e that underflows (|e| ~
+        # 1e-308); no K of the box reaches it, and inf > inf is False.
+        if lo - hi > feas_tol * max(1.0, abs(hi)) or hi == -_INF:
             return None
         hi = lo
     h = q * ei * ei + r

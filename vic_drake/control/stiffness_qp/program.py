@@ -14,7 +14,10 @@ from time import perf_counter
 import numpy as np
 
 from vic_drake.control.stiffness_qp.constraints import active_constraints
-from vic_drake.control.stiffness_qp.exact import solve_stiffness_qp_exact
+from vic_drake.control.stiffness_qp.exact import (
+    FEASIBILITY_TOL,
+    solve_stiffness_qp_exact,
+)
 from vic_drake.control.stiffness_qp.problem import (
     StiffnessQpProblem,
     StiffnessQpSolution,
@@ -186,7 +189,7 @@ class StiffnessQp:
                        qw[1], rw[1], unit, free)  # fmt: skip
         z = _axis_rows(e[2], ed[2], d[2], fr[2], fmn[2], fmx[2], kmn[2], kmx[2],
                        qw[2], rw[2], unit, free)  # fmt: skip
-        if x is None or y is None or z is None:  # e_i = 0, 0 outside its force rows.
+        if x is None or y is None or z is None:  # A force row no K of the box meets.
             return fallback_solution(problem, t0, "infeasible")
         (s0, c0, b0, lo0, hi0, flo0, fhi0) = x
         (s1, c1, b1, lo1, hi1, flo1, fhi1) = y
@@ -269,4 +272,11 @@ def _axis_rows(ei, edi, di, fri, fmin, fmax, kmin, kmax, q, r, unit, free):
         lo_f, hi_f = (
             (f_lo_row / c, f_hi_row / c) if c > 0.0 else (f_hi_row / c, f_lo_row / c)
         )
+        # A row that no K of the box meets is infeasible, as the exact oracle
+        # decides (the solver would get bounds beyond its infinity).
+        k_lo, k_hi = max(kmin, lo_f * s), min(kmax, hi_f * s)
+        if k_lo > k_hi and (
+            k_lo - k_hi > FEASIBILITY_TOL * max(1.0, abs(k_hi)) or k_hi == -math.inf
+        ):
+            return None
     return s, 2.0 * h * s * s, b, kmin / s, kmax / s, lo_f, hi_f
