@@ -37,21 +37,18 @@ def _positive(value: str, option: str) -> float:
 
 def _count(value: str) -> int:
     """--lateral-passes: an integer from 0 to MAX_LATERAL_PASSES."""
-    from vic_drake.experiments.lateral_replay import MAX_LATERAL_PASSES
+    from vic_drake.experiments.lateral_replay import (
+        MAX_LATERAL_PASSES,
+        check_lateral_passes,
+    )
 
     try:
-        n = int(value)
-    except ValueError:
+        return check_lateral_passes(int(value))
+    except (ValueError, VicDrakeError):
         raise VicDrakeError(
             f"--lateral-passes takes an integer from 0 to {MAX_LATERAL_PASSES}; "
             f"got {value!r}"
         ) from None
-    if not 0 <= n <= MAX_LATERAL_PASSES:
-        raise VicDrakeError(
-            f"--lateral-passes takes an integer from 0 to {MAX_LATERAL_PASSES}; "
-            f"got {value!r}"
-        )
-    return n
 
 
 def _surface_offset(value: str):

@@ -157,22 +157,21 @@ def _profile(real, phantom, first, lift, relaxation):
     """The two-anchor profile, the lift-off re-read with the profile as its
     relaxation history (two passes); None if the re-read is not plausible."""
     for _ in range(2):
-        xs, offs = [first.x_m, lift.x_m], [first.offset_m, lift.offset_m]
-        order = np.argsort(xs)
-        xs, offs = list(np.asarray(xs)[order]), list(np.asarray(offs)[order])
+        xs, offs = _anchors(first, lift)
         history = np.interp(real["x_m"].to_numpy(float), xs, offs)
         lift = lift_off_offset(
             real, phantom, relaxation=relaxation, history_offset_m=history
         )
         if lift is None or not _plausible_lift_off(lift):
             return None
-    xs, offs = [first.x_m, lift.x_m], [first.offset_m, lift.offset_m]
-    order = np.argsort(xs)
-    return {
-        "x_m": [float(xs[i]) for i in order],
-        "offset_m": [float(offs[i]) for i in order],
-        "lift_off": lift,
-    }
+    xs, offs = _anchors(first, lift)
+    return {"x_m": xs, "offset_m": offs, "lift_off": lift}
+
+
+def _anchors(first, lift) -> tuple[list[float], list[float]]:
+    """The two anchors' x and offsets, m, in increasing x."""
+    pairs = sorted([(first.x_m, first.offset_m), (lift.x_m, lift.offset_m)])
+    return [float(x) for x, _ in pairs], [float(o) for _, o in pairs]
 
 
 def _plausible(first) -> bool:

@@ -349,7 +349,7 @@ class TissueForceElement(LeafSystem):
 
     def _store(self, discrete_state, cached, terms, tick: float) -> None:
         """Stores the sample of the cached kinematics with ``terms``, for ``tick``."""
-        p_WT, v_WT, p_WPh = cached[5], cached[6], cached[7]
+        _, _, _, _, _, p_WT, v_WT, p_WPh, _ = cached
         force, eps, eps_dot, surface, kappa, lam = terms[:6]
         discrete_state.set_value(
             self._sample,

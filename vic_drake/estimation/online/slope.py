@@ -48,6 +48,7 @@ from typing import NamedTuple
 
 from vic_drake.estimation.online.params import OnlineEstimatorParams
 from vic_drake.estimation.online.slope_gram import (
+    GRAM_SIZE,
     SUMS_SIZE,
     add_sample,
     shift_basis,
@@ -70,7 +71,7 @@ _T_START = 2  # first contact sample since the reset
 _T_LAST = 3  # last good sample
 _COUNT = 4  # samples since the last solve
 _G = 5  # the sums of slope_gram: the upper triangle of the Gram matrix,
-_B = _G + 21  # its right-hand side (the force),
+_B = _G + GRAM_SIZE  # its right-hand side (the force),
 _FF = _G + SUMS_SIZE - 1  # the weighted sum of the squared forces
 _SLOPE = _FF + 1  # k of the last solve, N/m (NaN: none)
 _REL_STD = _SLOPE + 1  # its relative standard error

@@ -25,8 +25,10 @@ from __future__ import annotations
 
 import math
 
-#: Number of sums: 21 (Gram upper triangle) + 6 (right-hand side) + 1.
-SUMS_SIZE = 28
+#: Number of sums of the Gram matrix's upper triangle (the first sums).
+GRAM_SIZE = 21
+#: Number of sums: the Gram upper triangle, the 6 of the right-hand side, and 1.
+SUMS_SIZE = GRAM_SIZE + 6 + 1
 
 
 def add_sample(sums, w: float, tau: float, e: float, v: float, force: float):
@@ -198,4 +200,4 @@ def solve_sums(sums):
     return schur_z, coef_z, residual, g_inv_zz
 
 
-__all__ = ["SUMS_SIZE", "add_sample", "shift_basis", "solve_sums"]
+__all__ = ["GRAM_SIZE", "SUMS_SIZE", "add_sample", "shift_basis", "solve_sums"]
