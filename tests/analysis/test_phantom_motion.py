@@ -217,6 +217,30 @@ def test_simulated_scan_lift_is_recovered_within_its_band(simulated_scans):
 
 
 @pytest.mark.slow
+def test_out_of_contact_the_estimate_is_not_above_the_tip(simulated_scans):
+    """Where contact is lost the surface has left the tip: the estimate lies at
+    or under the tip's height (the loose bound above it only widens the band),
+    and so the replay loses contact where the log did."""
+    from vic_drake.tissue.phantom import load_phantom
+
+    df, _ = simulated_scans
+    phantom = load_phantom("synthetic")
+    est = estimate_phantom_motion(df, phantom)
+    t = est["t_s"].to_numpy()
+    x, y = df["x_m"].to_numpy(), df["y_m"].to_numpy()
+    # The map is the simulated tissue's own, so the baseline is ~0.
+    tip = df["z_m"].to_numpy() - np.asarray(phantom.surface_z(x, y))
+    motion = est["phantom_lift_m"].to_numpy()
+    err = motion - df["phantom_lift_m"].to_numpy()
+    losses = contact_loss_intervals(df)
+    assert losses
+    for t0, t1 in losses:
+        inside = (t > t0) & (t < t1)
+        assert np.max(motion[inside] - tip[inside]) < 0.1e-3
+        assert np.mean(err[inside]) < 2e-3
+
+
+@pytest.mark.slow
 def test_simulated_nominal_scan_has_no_significant_motion(simulated_scans):
     from vic_drake.tissue.phantom import load_phantom
 

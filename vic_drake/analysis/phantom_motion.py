@@ -198,8 +198,8 @@ def estimate_phantom_motion(
     the tip and came back at the penetration rates measured at the gap's
     ends, which bound the separation by a triangle (:func:`_gap_depth`). The
     estimate in the gap is the linear bridge between its contact ends, held
-    at most at the bound minus half that depth (the middle of the
-    triangle).
+    at most at the tip's own height (no penetration) minus half that depth
+    (the middle of the triangle); the bound is the band's edge.
 
     1-sigma band: in contact, the reference's error (``map_surface_sigma_m``
     for the map; for a nominal log, the RMS of the raw motion over the
@@ -208,9 +208,8 @@ def estimate_phantom_motion(
     kappa error on the penetration beyond the reference's
     (``kappa_rel_sigma |eps - eps_ref| / beta``), the force noise through
     the law and the RMS of the raw motion about its average within the
-    window, in quadrature. Out of contact, the bridged band plus the room
-    between the estimate and the bound plus the penetration at the contact
-    threshold and half the triangle's depth, in quadrature.
+    window, in quadrature. Out of contact, the bridged band, the penetration
+    at the contact threshold and half the triangle's depth, in quadrature.
 
     Args:
         df: canonical scan frame (t_s, x_m, y_m, z_m, force_sensor_z_N).
@@ -292,7 +291,9 @@ def estimate_phantom_motion(
     bridge = np.interp(t, t[keep], motion_c[keep])
     sigma_bridge = np.interp(t, t[keep], sigma_c[keep])
     depth = _gap_depth(t, keep, eps, smooth_s)
-    motion = np.where(keep, motion_c, np.minimum(bridge, upper - depth / 2))
+    # Capped at the tip's height, not at the bound (see the docstring).
+    tip_level = z - ref - base
+    motion = np.where(keep, motion_c, np.minimum(bridge, tip_level - depth / 2))
     eps_thr = (CONTACT_THRESHOLD_N / kappa) ** (1.0 / beta)
     sigma_gap = np.sqrt(sigma_bridge**2 + eps_thr**2 + (depth / 2) ** 2)
     sigma = np.where(keep, sigma_c, sigma_gap)
