@@ -36,6 +36,8 @@ from pathlib import Path
 import numpy as np
 from common import versions
 
+from vic_drake.analysis.columns import real_to_canonical
+from vic_drake.analysis.contact import contact_mask
 from vic_drake.analysis.phantom_motion import estimate_phantom_motion
 from vic_drake.experiments.compare_real import compare_real
 from vic_drake.experiments.real_logs import scenario_from_real_log
@@ -47,18 +49,20 @@ from vic_drake.scenario import DisturbanceConfig, PhantomLift
 from vic_drake.tissue.phantom import load_phantom
 from vic_drake.tissue.phantom.distorted import with_map_errors
 
-#: First event's start, s (after the approach and the first contact of every
-#: shared log), and the spacing of the events, s.
-FIRST_EVENT_S = 4.0
+#: The first event starts this long after the log's first contact, s (the
+#: surface calibration reads the rest surface at the first contact), and
+#: the events are this far apart, s.
+FIRST_EVENT_AFTER_CONTACT_S = 2.0
 EVENT_SPACING_S = 3.6
 
 
-def hand_lifts(seed: int, events: int) -> list[PhantomLift]:
-    """Random hand motion: each event a lift, then a fast drop below rest."""
+def hand_lifts(seed: int, events: int, first_s: float) -> list[PhantomLift]:
+    """Random hand motion from ``first_s``: each event a lift, then a fast
+    drop below rest."""
     rng = np.random.default_rng(seed)
     lifts = []
     for k in range(events):
-        t = FIRST_EVENT_S + k * EVENT_SPACING_S
+        t = first_s + k * EVENT_SPACING_S
         lifts.append(
             PhantomLift(
                 start_s=round(t, 3),
@@ -80,9 +84,13 @@ def hand_lifts(seed: int, events: int) -> list[PhantomLift]:
     return lifts
 
 
-def one_run(data_dir: Path, log: str, seed: int, events: int, out_dir: Path) -> dict:
+def one_run(
+    data_dir: Path, log: str, seed: int, events: int, out_dir: Path, keep: bool
+) -> dict:
     raw = read_bag(data_dir / "experiments" / log)
-    lifts = hand_lifts(seed, events)
+    contact = contact_mask(real_to_canonical(raw))
+    first_s = float(raw["t_s"].to_numpy()[np.argmax(contact)] - raw["t_s"].iloc[0])
+    lifts = hand_lifts(seed, events, first_s + FIRST_EVENT_AFTER_CONTACT_S)
     end_s = lifts[-1].start_s + lifts[-1].rise_s + lifts[-1].hold_s + lifts[-1].fall_s
     duration_s = min(float(raw["t_s"].iloc[-1] - raw["t_s"].iloc[0]), end_s + 2.0)
     scenario = scenario_from_real_log(
@@ -96,6 +104,9 @@ def one_run(data_dir: Path, log: str, seed: int, events: int, out_dir: Path) -> 
     truth = run_scan(scenario, phantom=tissue, duration_s=duration_s)
     bag = write_scan_bag(truth, out_dir / f"hand_{log}_{seed}")
     out, sim, real = compare_real(bag, data_dir=data_dir, return_frames=True)
+    if keep:
+        truth.df.to_pickle(out_dir / f"hand_{log}_{seed}_truth.pkl")
+        sim.to_pickle(out_dir / f"hand_{log}_{seed}_replay.pkl")
     # The estimate and the replay against the truth, on the bag's clock.
     t = real["t_s"].to_numpy()
     lift = np.interp(
@@ -115,6 +126,7 @@ def one_run(data_dir: Path, log: str, seed: int, events: int, out_dir: Path) -> 
 
     return {
         "seed": seed,
+        "first_event_s": lifts[0].start_s,
         "controller": out["controller"],
         "true_motion_max_mm": float(1e3 * np.max(np.abs(lift))),
         "est_rms_contact_mm": rms(err[after & measured]),
@@ -138,7 +150,11 @@ def main():
     parser.add_argument("--seeds", default="0")
     parser.add_argument("--events", type=int, default=5)
     parser.add_argument("--data-dir", default=None)
-    parser.add_argument("--keep", default=None, help="folder to keep the bags in")
+    parser.add_argument(
+        "--keep",
+        default=None,
+        help="folder to keep the bags in, with the true and the replayed scans (pickles)",
+    )
     args = parser.parse_args()
     try:
         seeds = [int(s) for s in args.seeds.split(",") if s.strip()]
@@ -160,7 +176,9 @@ def main():
         out_dir.mkdir(parents=True, exist_ok=True)
         for seed in seeds:
             t0 = time.perf_counter()
-            row = one_run(data_dir, args.log, seed, args.events, out_dir)
+            row = one_run(
+                data_dir, args.log, seed, args.events, out_dir, keep is not None
+            )
             row["wall_s"] = round(time.perf_counter() - t0, 1)
             print(" ".join(f"{k}={_fmt(v)}" for k, v in row.items()), flush=True)
 
