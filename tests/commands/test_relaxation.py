@@ -64,3 +64,58 @@ def test_bad_options(capsys, data_dir, argv, words):
 def test_missing_bag(capsys, tmp_path):
     status, _, err = run(capsys, ["fit-relaxation", tmp_path / "nope"])
     assert status == 2 and "does not exist" in err
+
+
+@pytest.mark.realdata
+def test_load_tests_held_out_by_phase(capsys, data_dir):
+    """The palpation fit's law on the load tests, phase by phase (measured):
+    the real force during the unloading and the release sits ABOVE the law
+    (it falls more slowly than the relaxing law says), plain HC's release
+    below; the relaxing law beats plain HC in the hold, unload and release."""
+    loads = [data_dir / "loadcycle" / f"test_soft_{k}" for k in (1, 2, 3)]
+    status, out, err = run(
+        capsys,
+        [
+            "fit-relaxation",
+            *(data_dir / "palpation" / n for n in ("test_soft_1hz", "test_soft_2hz")),
+            data_dir / "palpation" / "test_soft_25hz",
+            "--held-out",
+            *loads,
+            "--json",
+        ],
+    )
+    assert status == 0, err
+    held = json.loads(out)["held_out"]
+    for bag in loads:
+        phases = held[str(bag)]["phases"]
+        assert list(phases) == ["load", "hold", "unload", "release"]
+        for name in ("unload", "release"):
+            assert 0.05 < phases[name]["mean_N"] < 0.15
+        assert phases["release"]["hc_mean_N"] < -0.1
+        for name in ("hold", "unload", "release"):
+            assert phases[name]["rms_N"] < phases[name]["hc_rms_N"]
+
+
+@pytest.mark.realdata
+def test_a_fitted_load_test_takes_the_palpations_median_lag(capsys, data_dir):
+    """A fitted log whose lag is not identified (estimated at 0) is aligned
+    by the median of the identified ones, as a held-out log is."""
+    status, out, err = run(
+        capsys,
+        [
+            "fit-relaxation",
+            data_dir / "palpation" / "test_soft_1hz",
+            data_dir / "palpation" / "test_soft_25hz",
+            data_dir / "loadcycle" / "test_soft_1",
+            "--json",
+        ],
+    )
+    assert status == 0, err
+    fitted = json.loads(out)["fitted"]
+    lags = [
+        fitted[str(data_dir / "palpation" / n)]["lag_s"]
+        for n in ("test_soft_1hz", "test_soft_25hz")
+    ]
+    assert min(lags) > 0.0
+    load_lag = fitted[str(data_dir / "loadcycle" / "test_soft_1")]["lag_s"]
+    assert load_lag == pytest.approx(sum(lags) / 2)

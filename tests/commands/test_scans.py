@@ -123,3 +123,15 @@ def test_scan_command_writes_the_rigs_bag_and_checks_its_path_first(tmp_path, ca
     out = json.loads(capsys.readouterr().out)
     assert out["bag"] == str(bag)
     assert read_bag(bag, expect="scan").attrs["topic"] == "/data_control"
+
+
+@pytest.mark.parametrize(
+    "value", ["0.08", "0.08:22.9,0.1", "0.6:1,0.5:2", "0.1:0", "a:b"]
+)
+def test_compare_real_rejects_a_bad_relaxation_before_reading_the_bag(
+    tmp_path, capsys, value
+):
+    assert main(["compare-real", str(tmp_path), "--relaxation", value]) == 2
+    err = capsys.readouterr().err
+    assert "--relaxation takes G:TAU pairs" in err and repr(value) in err
+    assert "Traceback" not in err

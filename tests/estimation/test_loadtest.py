@@ -96,3 +96,38 @@ def test_load_test_figure(tmp_path):
         and "Hunt-Crossley" in labels[2]
     )
     assert (tmp_path / "fig2.png").stat().st_size > 10_000
+
+
+def test_load_test_phases_follow_the_target():
+    from vic_drake.estimation.loadtest import load_test_phases
+
+    t = 0.002 * np.arange(8000)  # 16 s
+    # Down 15 mm in 0.75 s, hold to 10.75 s, up 15 mm in 1.5 s, then still.
+    target = -np.interp(t, [0.0, 0.75, 10.75, 12.25, 16.0], [0, 15, 15, 0, 0]) * 1e-3
+    phases = load_test_phases(t, target)
+    assert list(phases) == ["load", "hold", "unload", "release"]
+    edges = {name: (t[m].min(), t[m].max()) for name, m in phases.items()}
+    assert edges["load"][1] == pytest.approx(0.75, abs=0.005)
+    assert edges["hold"][0] == pytest.approx(0.75, abs=0.005)
+    assert edges["unload"] == pytest.approx((10.75, 12.25), abs=0.005)
+    assert edges["release"][0] == pytest.approx(12.25, abs=0.005)
+    # The phases split the log: every sample in exactly one.
+    assert np.all(sum(m.astype(int) for m in phases.values()) == 1)
+    # A sinusoidal palpation, a target that only holds, no target: not a load test.
+    assert load_test_phases(t, 0.008 * np.sin(2 * np.pi * t)) is None
+    assert load_test_phases(t, np.zeros_like(t)) is None
+    assert load_test_phases(t, None) is None
+
+
+@pytest.mark.realdata
+@pytest.mark.parametrize("name", LOAD_LOGS)
+def test_real_load_test_phases(data_dir, name):
+    from vic_drake.estimation.loadtest import load_test_phases
+
+    data = PalpationData.from_frame(read_bag(data_dir / "loadcycle" / name))
+    phases = load_test_phases(data.t_s, data.z_target_m)
+    t = data.t_s - data.t_s[0]
+    # The logged protocol: 0.75 s down, hold to 10.75 s, 1.5 s up.
+    assert t[phases["load"]].max() == pytest.approx(0.75, abs=0.01)
+    assert t[phases["unload"]].min() == pytest.approx(10.75, abs=0.01)
+    assert t[phases["unload"]].max() == pytest.approx(12.25, abs=0.01)

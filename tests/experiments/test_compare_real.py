@@ -92,3 +92,42 @@ def test_compare_real_rejects_an_unknown_tissue_law_before_simulating(data_dir):
 
     with pytest.raises(VicDrakeError, match="tissue_law must be one of"):
         compare_real(data_dir / "experiments" / "test_force_control", tissue_law="kv")
+
+
+@pytest.mark.realdata
+def test_compare_real_rejects_a_relaxation_on_plain_hc_before_simulating(data_dir):
+    from vic_drake.errors import VicDrakeError
+    from vic_drake.tissue import RelaxationParams
+
+    rel = RelaxationParams((0.03,), (1.7,))
+    with pytest.raises(VicDrakeError, match="needs the 'relaxing' tissue law"):
+        compare_real(
+            data_dir / "experiments" / "test_force_control",
+            tissue_law="hc",
+            relaxation=rel,
+        )
+    with pytest.raises(VicDrakeError, match="RelaxationParams or None"):
+        compare_real(
+            data_dir / "experiments" / "test_force_control", relaxation=[(0.03, 1.7)]
+        )
+
+
+@pytest.mark.realdata
+def test_compare_real_simulates_the_given_relaxation(data_dir):
+    """A short run on a given relaxation: echoed, and the simulated force
+    differs from the default law's (the same run otherwise)."""
+    from vic_drake.tissue import RelaxationParams
+
+    bag = data_dir / "experiments" / "test_force_control"
+    rel = RelaxationParams((0.3,), (0.5,))
+    out, sim, _ = compare_real(
+        bag, data_dir=data_dir, duration_s=2.5, relaxation=rel, return_frames=True
+    )
+    base, sim0, _ = compare_real(
+        bag, data_dir=data_dir, duration_s=2.5, return_frames=True
+    )
+    assert out["tissue_relaxation"] == {"fractions": [0.3], "time_constants_s": [0.5]}
+    assert "tissue_relaxation" not in base
+    assert out["tissue_law"] == base["tissue_law"] == "relaxing"
+    # Under force control the tip sinks further into the more relaxing tissue.
+    assert sim["z_m"].iloc[-1] < sim0["z_m"].iloc[-1] - 1e-4

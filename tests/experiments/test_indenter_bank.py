@@ -60,3 +60,23 @@ def test_indenter_diagram_static_equilibrium_matches_hunt_crossley(relaxation):
         )
         assert s[i] - q[i] == pytest.approx(eps, abs=2e-6)
         assert measured[i] == pytest.approx(kappa_eq[i] * eps**BETA, rel=1e-3)
+
+
+def test_simulated_palpations_take_any_number_of_branches():
+    """Two branches, the second with g = 0, palpate exactly as one branch;
+    with g > 0 the second branch lowers the force once it has built up."""
+    from vic_drake.experiments import CampaignParams, simulate_palpations
+
+    params = CampaignParams(palpation=PalpationParams(duration_s=3.0), seed=0)
+    point = dict(surface_z=[0.1], kappa=[4000.0], lam=[2e4], beta=BETA, params=params)
+
+    def force(relaxation):
+        (rec,) = simulate_palpations([0.0], [0.0], relaxation=relaxation, **point)
+        return rec.force_N
+
+    one = force(FAST)
+    padded = force(RelaxationParams((0.3, 0.0), (0.2, 5.0)))
+    two = force(RelaxationParams((0.3, 0.1), (0.2, 0.5)))
+    np.testing.assert_array_equal(padded, one)
+    late = slice(-500, None)  # The last second of contact.
+    assert np.mean(two[late]) < 0.95 * np.mean(one[late])

@@ -22,3 +22,20 @@ def test_options_reject_a_data_dir_without_data(tmp_path):
 def test_cli_unknown_stage_is_a_clean_error(tmp_path, capsys):
     assert main(["reproduce", "--out", str(tmp_path), "--stages", "bogus"]) == 2
     assert "unknown stage" in capsys.readouterr().err
+
+
+def test_options_take_a_relaxation_and_reject_anything_else(tmp_path):
+    from vic_drake.tissue import RelaxationParams
+
+    rel = RelaxationParams((0.03, 0.09), (1.7, 65.0))
+    assert ReproduceOptions(out_dir=tmp_path, relaxation=rel).relaxation is rel
+    assert ReproduceOptions(out_dir=tmp_path).relaxation is None
+    with pytest.raises(VicDrakeError, match="relaxation must be"):
+        ReproduceOptions(out_dir=tmp_path, relaxation=(0.03, 1.7))
+
+
+def test_cli_bad_relaxation_is_a_clean_error(tmp_path, capsys):
+    argv = ["reproduce", "--out", str(tmp_path), "--relaxation", "0.3:-1"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "--relaxation takes G:TAU pairs" in err and "Traceback" not in err

@@ -56,3 +56,28 @@ def parse_float_list(text: str, option: str) -> list[float]:
     if not values:
         raise VicDrakeError(f"{option} needs at least one number; got {text!r}")
     return values
+
+
+def parse_relaxation(text: str, option: str = "--relaxation"):
+    """``option`` G:TAU[,G:TAU...]: the relaxing law's branches (RelaxationParams)."""
+    from vic_drake.tissue.relaxation import RelaxationParams
+
+    usage = (
+        f"{option} takes G:TAU pairs separated by commas (fraction g >= 0, "
+        "the fractions summing to < 1; time constant tau > 0 s), e.g. "
+        f"0.08:22.9,0.03:1.7; got {text!r}"
+    )
+    pairs = []
+    for item in text.split(","):
+        parts = item.split(":")
+        try:
+            g, tau = (float(v) for v in parts)
+        except ValueError:
+            raise VicDrakeError(usage) from None
+        pairs.append((g, tau))
+    try:
+        return RelaxationParams(
+            tuple(g for g, _ in pairs), tuple(tau for _, tau in pairs)
+        )
+    except VicDrakeError:
+        raise VicDrakeError(usage) from None

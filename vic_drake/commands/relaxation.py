@@ -30,19 +30,33 @@ def _initial_time_constants(text: str | None) -> tuple[float, ...]:
 
 
 def _aligned(bags, args, say) -> tuple[dict, dict]:
-    """{name: aligned PalpationData}, {name: lag_s} of bag folders."""
+    """{name: aligned PalpationData}, {name: lag_s} of bag folders.
+
+    Each log is aligned by its own estimated lag (or ``--lag``); a lag
+    estimated at 0 (not identified: a load test has no sinusoid) takes the
+    median of the other logs' identified lags, when there are any.
+    """
+    import numpy as np
+
     from vic_drake.estimation.palpation import estimate_lag, shift
 
-    logs, lags = {}, {}
+    raw, lags = {}, {}
     for text in bags:
         data = _read_palpation(text, "bag")
         name = text.rstrip("/")
-        if name in logs:
+        if name in raw:
             raise VicDrakeError(f"bag {text!r} is given twice")
-        lag = args.lag if args.lag is not None else estimate_lag(data, args.max_lag)
+        raw[name] = data
+        lags[name] = (
+            args.lag if args.lag is not None else estimate_lag(data, args.max_lag)
+        )
+    identified = [v for v in lags.values() if v > 0.0]
+    if args.lag is None and identified:
+        median = float(np.median(identified))
+        lags = {n: v if v > 0.0 else median for n, v in lags.items()}
+    for name, lag in lags.items():
         say(f"  {name}: sensor lag {lag * 1e3:.1f} ms")
-        logs[name], lags[name] = shift(data, lag), lag
-    return logs, lags
+    return {n: shift(d, lags[n]) for n, d in raw.items()}, lags
 
 
 def _fit_relaxation(args) -> int:
@@ -118,6 +132,7 @@ def _fit_relaxation(args) -> int:
                 "hc_kappa": e.hc_kappa,
                 "hc_lam": e.hc_lam,
                 "samples": e.n_samples,
+                "phases": e.phases,
             }
             for n, e in held.items()
         },
@@ -133,10 +148,16 @@ def _fit_relaxation(args) -> int:
         f"  fitted {n}: RMS {v['rms_N']:.4f} N relaxing, {v['hc_rms_N']:.4f} N plain HC"
         for n, v in out["fitted"].items()
     ]
-    lines += [
-        f"  held out {n}: RMS {v['rms_N']:.4f} N relaxing, {v['hc_rms_N']:.4f} N plain HC"
-        for n, v in out["held_out"].items()
-    ]
+    for n, v in out["held_out"].items():
+        lines.append(
+            f"  held out {n}: RMS {v['rms_N']:.4f} N relaxing, {v['hc_rms_N']:.4f} N "
+            "plain HC"
+        )
+        for phase, p in (v["phases"] or {}).items():
+            lines.append(
+                f"    {phase:8s} RMS {p['rms_N']:.4f} N (mean {p['mean_N']:+.4f}) "
+                f"relaxing, {p['hc_rms_N']:.4f} N ({p['hc_mean_N']:+.4f}) plain HC"
+            )
     emit(out, args.json, "\n".join(lines))
     return 0
 

@@ -11,6 +11,7 @@ from vic_drake.commands.common import (
     add_data_dir_option,
     add_json_option,
     emit,
+    parse_relaxation,
 )
 
 #: Exit statuses of ``vic-drake reproduce`` (documented in its --help).
@@ -66,6 +67,14 @@ def register(subparsers) -> None:
         help="after the run, serve the replay live in Meshcat (prints its URL) until "
         "Ctrl-C",
     )
+    parser.add_argument(
+        "--relaxation",
+        metavar="G:TAU[,G:TAU...]",
+        default=None,
+        help="branches of the relaxing tissue (fraction g, time constant tau in s) in "
+        "every simulation of the run (default: vic_drake.tissue.DEFAULT_RELAXATION, "
+        "0.08:22.9)",
+    )
     add_data_dir_option(parser)
     add_json_option(parser)
     parser.add_argument("--quiet", action="store_true", help="no progress on stderr")
@@ -120,6 +129,9 @@ def _run(args: argparse.Namespace) -> int:
         stages=stages,
         meshcat=args.meshcat,
         progress=progress,
+        relaxation=None
+        if args.relaxation is None
+        else parse_relaxation(args.relaxation),
     )
     result = reproduce(options)
     summary = result.summary()

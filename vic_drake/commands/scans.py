@@ -20,6 +20,7 @@ from vic_drake.commands.common import (
     add_data_dir_option,
     add_json_option,
     emit,
+    parse_relaxation,
 )
 from vic_drake.errors import VicDrakeError
 from vic_drake.paths import PLOT_SUFFIXES, check_output_file
@@ -133,6 +134,14 @@ def register(subparsers) -> None:
         "or plain Hunt-Crossley",
     )
     p.add_argument(
+        "--relaxation",
+        metavar="G:TAU[,G:TAU...]",
+        default=None,
+        help="branches of the relaxing law (fraction g, time constant tau in s), "
+        "in the simulated tissue and the lift-off correction (default: "
+        "vic_drake.tissue.DEFAULT_RELAXATION, 0.08:22.9)",
+    )
+    p.add_argument(
         "--surface-offset",
         metavar="MM|auto|none",
         default=None,
@@ -213,6 +222,7 @@ def run_compare_real(args: argparse.Namespace) -> int:
         None if args.surface_offset is None else _surface_offset(args.surface_offset)
     )
     passes = 0 if args.lateral_passes is None else _count(args.lateral_passes)
+    relaxation = None if args.relaxation is None else parse_relaxation(args.relaxation)
     # Output paths are checked before simulating: a bad one fails now.
     if args.out:
         check_output_file(args.out, "--out", LOG_SUFFIXES)
@@ -228,6 +238,7 @@ def run_compare_real(args: argparse.Namespace) -> int:
         data_dir=args.data_dir,
         duration_s=duration,
         tissue_law=args.tissue_law,
+        relaxation=relaxation,
         surface_offset=offset,
         lateral_passes=passes,
         progress=progress,

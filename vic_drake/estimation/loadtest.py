@@ -44,6 +44,41 @@ from vic_drake.paper import BEST_BETA
 
 MIN_LOAD_SAMPLES = 50
 
+#: Target speed above which a load test's target counts as moving, m/s (the
+#: logged ramps run at 10-30 mm/s).
+MIN_TARGET_SPEED_M_PER_S = 1e-3
+
+#: The phases of a load test, in time order (see :func:`load_test_phases`).
+LOAD_TEST_PHASES = ("load", "hold", "unload", "release")
+
+
+def load_test_phases(t_s, z_target_m) -> dict | None:
+    """Splits a load test by its target: {phase: (n,) bool}, or None.
+
+    The phases (:data:`LOAD_TEST_PHASES`): ``load`` up to the end of the
+    target's descent, ``hold`` until the target starts to rise, ``unload``
+    while it rises, ``release`` after it stops (the tip, held by a compliant
+    controller, is still leaving the tissue). None when the target does not
+    descend once and then rise once (a palpation, or a log without target).
+    """
+    t = np.asarray(t_s, float)
+    if z_target_m is None or t.size < 3:
+        return None
+    rate = np.gradient(np.asarray(z_target_m, float), t)
+    down = np.flatnonzero(rate < -MIN_TARGET_SPEED_M_PER_S)
+    up = np.flatnonzero(rate > MIN_TARGET_SPEED_M_PER_S)
+    if down.size == 0 or up.size == 0 or up[0] <= down[-1]:
+        return None
+    if np.any(np.diff(down) > 1) or np.any(np.diff(up) > 1):
+        return None  # More than one descent or rise: not a load cycle.
+    t_load, t_rise, t_top = t[down[-1]], t[up[0]], t[up[-1]]
+    return {
+        "load": t <= t_load,
+        "hold": (t > t_load) & (t < t_rise),
+        "unload": (t >= t_rise) & (t <= t_top),
+        "release": t > t_top,
+    }
+
 
 def predict_force(
     fit: HuntCrossleyFit | KelvinVoigtFit,

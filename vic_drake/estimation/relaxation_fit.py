@@ -31,6 +31,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from vic_drake.errors import VicDrakeError
+from vic_drake.estimation.loadtest import load_test_phases
 from vic_drake.estimation.palpation.data import (
     DEFAULT_INDENTER_MASS_KG,
     PalpationData,
@@ -249,6 +250,11 @@ class HeldOutError:
             kappa, lam). hc_rms_N: plain Hunt-Crossley (refitted kappa, lam).
         kappa, lam: the relaxing law's refit. hc_kappa, hc_lam: HC's.
         n_samples: samples scored.
+        phases: for a load test (:func:`~vic_drake.estimation.loadtest.load_test_phases`),
+            {phase: {"samples", "rms_N", "hc_rms_N", "mean_N", "hc_mean_N"}}
+            over the scored samples of each phase, where mean is the mean of
+            measured minus model (> 0: the log's force is above the law's);
+            else None.
     """
 
     relaxing_rms_N: float
@@ -258,6 +264,7 @@ class HeldOutError:
     hc_kappa: float
     hc_lam: float
     n_samples: int
+    phases: dict | None = None
 
 
 def held_out_errors(
@@ -299,7 +306,28 @@ def held_out_errors(
             hc_kappa=float(hc_kappa),
             hc_lam=float(hc_lam),
             n_samples=int(log.mask.sum()),
+            phases=_phase_errors(data, log.mask, r, r_hc),
         )
+    return out
+
+
+def _phase_errors(data: PalpationData, mask, r, r_hc) -> dict | None:
+    """Per-phase RMS and mean residuals of a load test (None otherwise)."""
+    phases = load_test_phases(data.t_s, data.z_target_m)
+    if phases is None:
+        return None
+    out = {}
+    for phase, where in phases.items():
+        sel = where[mask]
+        if not sel.any():
+            continue
+        out[phase] = {
+            "samples": int(sel.sum()),
+            "rms_N": float(np.sqrt(np.mean(r[sel] ** 2))),
+            "hc_rms_N": float(np.sqrt(np.mean(r_hc[sel] ** 2))),
+            "mean_N": float(np.mean(r[sel])),
+            "hc_mean_N": float(np.mean(r_hc[sel])),
+        }
     return out
 
 

@@ -47,7 +47,7 @@ from vic_drake.station.params import StationParams
 from vic_drake.tissue import TISSUE_LAWS
 from vic_drake.tissue.phantom import load_phantom
 from vic_drake.tissue.phantom.distorted import with_map_errors, with_surface_profile
-from vic_drake.tissue.relaxation import tissue_relaxation
+from vic_drake.tissue.relaxation import RelaxationParams, tissue_relaxation
 
 
 def phantom_replay(bag: Path, real, phantom):
@@ -88,6 +88,7 @@ def compare_real(
     data_dir=None,
     duration_s: float | None = None,
     tissue_law: str | None = None,
+    relaxation: RelaxationParams | None = None,
     surface_offset: float | str | None = None,
     lateral_passes: int = 0,
     progress=None,
@@ -128,7 +129,11 @@ def compare_real(
         ``controller_identified`` holds what was identified from the log
         (:func:`~vic_drake.experiments.real_logs.identify_real_log`) and
         ``tissue_law`` the simulated tissue's law ("relaxing" unless
-        ``tissue_law`` says "hc"). ``surface_offset_mm`` is the offset
+        ``tissue_law`` says "hc"). ``relaxation`` replaces the relaxing
+        law's branches (default :data:`~vic_drake.tissue.DEFAULT_RELAXATION`)
+        in the simulated tissue and in the surface calibration's lift-off
+        correction; it is echoed as ``tissue_relaxation`` (appended last).
+        ``surface_offset_mm`` is the offset
         applied, ``surface_offset_source`` where it came from; the log's
         evidence: ``surface_first_contact_mm`` (and its ``_sigma_mm``),
         ``controller_map_offset_mm``, the lift-off's
@@ -157,6 +162,17 @@ def compare_real(
         raise VicDrakeError(
             f"tissue_law must be one of {list(TISSUE_LAWS)}; got {tissue_law!r}"
         )
+    law = tissue_law if tissue_law is not None else StationParams().tissue_law
+    if relaxation is not None:
+        if not isinstance(relaxation, RelaxationParams):
+            raise VicDrakeError(
+                "relaxation must be a RelaxationParams or None; got "
+                f"{type(relaxation).__name__}"
+            )
+        if law != "relaxing":
+            raise VicDrakeError(
+                f"a relaxation needs the 'relaxing' tissue law; got {law!r}"
+            )
     surface_offset = parse_surface_offset(surface_offset)
     lateral_passes = check_lateral_passes(lateral_passes)
     # The controller first: a log whose signals cannot tell fails before the
@@ -170,9 +186,11 @@ def compare_real(
     )
     real = real_to_canonical(raw)
     published = load_phantom("measured", data_dir=data_dir, lookup="bilinear")
-    law = tissue_law if tissue_law is not None else StationParams().tissue_law
     surface = surface_calibration(
-        real, published, surface_offset, relaxation=tissue_relaxation(law)
+        real,
+        published,
+        surface_offset,
+        relaxation=tissue_relaxation(law) if relaxation is None else relaxation,
     )
     profile = surface["profile"]
     # The simulated tissue: the published map raised by the offset (or the
@@ -213,10 +231,15 @@ def compare_real(
     )
     if tissue_law is not None:
         scenario.station.tissue_law = tissue_law
+    if relaxation is not None:
+        scenario.station.tissue_relaxation_fractions = list(relaxation.fractions)
+        scenario.station.tissue_relaxation_time_constants_s = list(
+            relaxation.time_constants_s
+        )
     if surface["offset_m"] != 0.0 and profile is None:
         # The controller reads the published map, as the real one read its own.
         scenario.variations.map_errors.surface_offset_m = -surface["offset_m"]
-    if tissue_law is not None or surface["offset_m"] != 0.0:
+    if tissue_law is not None or relaxation is not None or surface["offset_m"] != 0.0:
         scenario.validate()
     if progress:
         progress(scenario.description)
@@ -287,6 +310,11 @@ def compare_real(
     out.update(_lift_off_keys(surface["lift_off"], surface["profile"]))
     out["lateral_passes"] = lateral_passes
     out["lateral_rms_mm"] = lateral_rms
+    if relaxation is not None:
+        out["tissue_relaxation"] = {
+            "fractions": list(relaxation.fractions),
+            "time_constants_s": list(relaxation.time_constants_s),
+        }
     if return_frames:
         return out, result.df, real
     return out

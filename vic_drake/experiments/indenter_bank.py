@@ -44,6 +44,7 @@ from vic_drake.systems.indenter import (
     PalpationTarget,
     SensorParams,
 )
+from vic_drake.tissue.relaxation import DEFAULT_RELAXATION, RelaxationParams
 
 
 @dataclass
@@ -95,6 +96,7 @@ def MakeIndenterDiagram(
     indenter: IndenterParams | None = None,
     sensor: SensorParams | None = None,
     palpation: PalpationParams | None = None,
+    relaxation: RelaxationParams | None = DEFAULT_RELAXATION,
 ) -> IndenterBank:
     """Builds n servo-driven 1-DOF indenters palpating Hunt-Crossley tissue.
 
@@ -102,6 +104,9 @@ def MakeIndenterDiagram(
         n: number of indenters (one prismatic joint each).
         beta: Hunt-Crossley exponent of the tissue.
         indenter, sensor, palpation: parameters (defaults as documented).
+        relaxation: the tissue's relaxation as built (its branch count is
+            fixed here; the values can be changed per context with
+            ``tissue.set_relaxation``); None: plain HC without state.
 
     Returns:
         An :class:`IndenterBank`; loggers sample at the sensor rate:
@@ -140,7 +145,9 @@ def MakeIndenterDiagram(
         actuator.set_controller_gains(gains)
     plant.Finalize()
 
-    tissue = builder.AddNamedSystem("tissue", HuntCrossleyIndentation(n, beta))
+    tissue = builder.AddNamedSystem(
+        "tissue", HuntCrossleyIndentation(n, beta, relaxation=relaxation)
+    )
     force_sensor = builder.AddNamedSystem(
         "ft_sensor",
         LaggedForceSensor(n, sensor, indenter_mass_kg=indenter.indenter_mass_kg),

@@ -64,8 +64,8 @@ def simulate_palpations(
         params: the campaign (palpation, indenter, sensor).
         seed: seed of the sensor noise.
         relaxation: the tissue's relaxation (:mod:`vic_drake.tissue.relaxation`,
-            with as many branches as :data:`~vic_drake.tissue.DEFAULT_RELAXATION`);
-            None: plain Hunt-Crossley tissue.
+            any number of branches); None: plain Hunt-Crossley tissue (the
+            one-branch element with g = 0).
     """
     x, y, surface_z, kappa, lam = (
         np.atleast_1d(np.asarray(a, float)) for a in (x, y, surface_z, kappa, lam)
@@ -81,7 +81,12 @@ def simulate_palpations(
         raise VicDrakeError("simulate_palpations: surface_z, kappa, lam must be finite")
     pal = params.palpation
     bank = MakeIndenterDiagram(
-        n, beta=beta, indenter=params.indenter, sensor=params.sensor, palpation=pal
+        n,
+        beta=beta,
+        indenter=params.indenter,
+        sensor=params.sensor,
+        palpation=pal,
+        relaxation=relaxation or DEFAULT_RELAXATION,
     )
     context = bank.diagram.CreateDefaultContext()
     bank.set_points(

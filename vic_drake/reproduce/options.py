@@ -8,6 +8,7 @@ from pathlib import Path
 
 from vic_drake.errors import VicDrakeError
 from vic_drake.paths import check_data_dir, has_data, resolve_data_dir
+from vic_drake.tissue.relaxation import RelaxationParams
 
 
 @dataclass
@@ -25,6 +26,9 @@ class ReproduceOptions:
         meshcat: keep the replay's Meshcat server for a live view (the result's
             ``results["replay"]["meshcat"]``).
         progress: called with one line of progress text.
+        relaxation: the relaxing tissue's branches in every simulation of the
+            run (palpations, scans, compare-real); None (the default):
+            :data:`vic_drake.tissue.DEFAULT_RELAXATION`.
     """
 
     out_dir: Path
@@ -34,9 +38,17 @@ class ReproduceOptions:
     stages: tuple[str, ...] | None = None
     meshcat: bool = False
     progress: Callable[[str], None] = lambda message: None
+    relaxation: RelaxationParams | None = None
 
     def __post_init__(self):
         self.out_dir = Path(self.out_dir)
+        if self.relaxation is not None and not isinstance(
+            self.relaxation, RelaxationParams
+        ):
+            raise VicDrakeError(
+                "relaxation must be a vic_drake.tissue.RelaxationParams or None, got "
+                f"{type(self.relaxation).__name__}"
+            )
         if self.phantom not in ("auto", "measured", "synthetic"):
             raise VicDrakeError(
                 f"phantom must be 'auto', 'measured' or 'synthetic', got {self.phantom!r}"

@@ -42,7 +42,7 @@ from vic_drake.station.rig import AddRig
 from vic_drake.station.servo import joint_servo_rest_state
 from vic_drake.systems.ft_sensor import ForceTorqueSensor
 from vic_drake.systems.tissue_force import TissueForceElement
-from vic_drake.tissue import Phantom, tissue_relaxation
+from vic_drake.tissue import Phantom
 
 
 def MakeStation(
@@ -122,7 +122,7 @@ def MakeStation(
             friction_coefficient=params.tissue_friction_coefficient,
             slip_speed_m_per_s=params.tissue_slip_speed_m_per_s,
             along_normal=params.tissue_force_along_normal,
-            relaxation=tissue_relaxation(params.tissue_law),
+            relaxation=params.relaxation,
             update_period_s=params.plant.time_step,
         ),
     )

@@ -22,7 +22,11 @@ from pydrake.multibody.plant import MultibodyPlantConfig
 
 from vic_drake.errors import VicDrakeError
 from vic_drake.paper import GRAVITY_M_PER_S2
-from vic_drake.tissue.relaxation import TISSUE_LAWS
+from vic_drake.tissue.relaxation import (
+    TISSUE_LAWS,
+    RelaxationParams,
+    tissue_relaxation,
+)
 
 #: Drake's discrete contact solvers the station supports.
 CONTACT_APPROXIMATIONS = ("sap", "lagged")
@@ -144,6 +148,11 @@ class StationParams:
     # the instantaneous modulus) or "hc" (plain Hunt-Crossley); see
     # docs/decisions.md, "Tissue relaxation".
     tissue_law: str = "relaxing"
+    # Branches of the "relaxing" law, to study another relaxation: fractions
+    # g_i and time constants tau_i (s), one of each per branch. Both empty
+    # (the default): vic_drake.tissue.DEFAULT_RELAXATION. Not with "hc".
+    tissue_relaxation_fractions: list[float] = field(default_factory=list)
+    tissue_relaxation_time_constants_s: list[float] = field(default_factory=list)
     # Grid of the force element's per-step lookup of non-grid phantoms, m
     # (a GridPhantom is looked up on its own grid).
     tissue_lookup_resolution_m: float = 0.0005
@@ -228,12 +237,62 @@ class StationParams:
                 f"StationParams.tissue_law must be one of {TISSUE_LAWS}, got "
                 f"{self.tissue_law!r}"
             )
+        self._validate_relaxation()
         for name in ("robot_contact", "tissue_force_along_normal"):
             if not isinstance(getattr(self, name), bool):
                 raise VicDrakeError(
                     f"StationParams.{name} must be a bool, got {getattr(self, name)!r}"
                 )
         return self
+
+    def _validate_relaxation(self) -> None:
+        g = self.tissue_relaxation_fractions
+        tau = self.tissue_relaxation_time_constants_s
+        for name, values in (
+            ("tissue_relaxation_fractions", g),
+            ("tissue_relaxation_time_constants_s", tau),
+        ):
+            if not isinstance(values, (list, tuple)) or not all(
+                isinstance(v, (int, float)) and not isinstance(v, bool) for v in values
+            ):
+                raise VicDrakeError(
+                    f"StationParams.{name} must be a list of numbers, got {values!r}"
+                )
+        if len(g) != len(tau):
+            raise VicDrakeError(
+                "StationParams.tissue_relaxation_fractions and "
+                "tissue_relaxation_time_constants_s must have one value per branch, "
+                f"got {list(g)!r} and {list(tau)!r}"
+            )
+        if not g:
+            return
+        if self.tissue_law != "relaxing":
+            raise VicDrakeError(
+                "StationParams.tissue_relaxation_fractions / _time_constants_s are "
+                f"given ({list(g)!r}, {list(tau)!r}) but tissue_law is "
+                f"{self.tissue_law!r}; they need tissue_law 'relaxing'"
+            )
+        if not all(np.isfinite(v) and v >= 0.0 for v in g) or not sum(g) < 1.0:
+            raise VicDrakeError(
+                "StationParams.tissue_relaxation_fractions must be finite, >= 0 and "
+                f"sum to < 1, got {list(g)!r}"
+            )
+        if not all(np.isfinite(v) and v > 0.0 for v in tau):
+            raise VicDrakeError(
+                "StationParams.tissue_relaxation_time_constants_s must be finite "
+                f"and > 0 s, got {list(tau)!r}"
+            )
+
+    @property
+    def relaxation(self) -> RelaxationParams | None:
+        """The tissue element's relaxation: None for plain HC ("hc"); the
+        given branches, else :data:`vic_drake.tissue.DEFAULT_RELAXATION`."""
+        if self.tissue_law == "relaxing" and self.tissue_relaxation_fractions:
+            return RelaxationParams(
+                tuple(self.tissue_relaxation_fractions),
+                tuple(self.tissue_relaxation_time_constants_s),
+            )
+        return tissue_relaxation(self.tissue_law)
 
     def _validate_plant(self) -> None:
         config = self.plant

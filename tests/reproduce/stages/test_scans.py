@@ -32,6 +32,20 @@ def test_scan_scenarios_cover_the_paper_runs():
     assert lim.power_max_W == pytest.approx(0.1) and lim.eps_d_m == 0.008
 
 
+def test_scan_scenarios_take_a_relaxation():
+    from vic_drake.reproduce import scan_scenario
+    from vic_drake.tissue import DEFAULT_RELAXATION, RelaxationParams
+
+    rel = RelaxationParams((0.03, 0.09), (1.7, 65.0))
+    given = scan_scenario(
+        "cs", disturbed=True, phantom_kind="synthetic", quick=True, relaxation=rel
+    )
+    assert given.station.relaxation == rel
+    plain = scan_scenario("cs", disturbed=True, phantom_kind="synthetic", quick=True)
+    assert plain.station.relaxation is DEFAULT_RELAXATION
+    assert plain.station.tissue_relaxation_fractions == []
+
+
 def test_the_paper_scans_are_built_from_the_diagram_files(monkeypatch, tmp_path):
     """reproduce reads diagrams/*.yaml: a changed file changes the scan."""
     import importlib

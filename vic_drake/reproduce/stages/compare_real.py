@@ -17,8 +17,10 @@ def _compare_real_job(args):
     # Function-local: pydrake (heavy).
     from vic_drake.experiments import compare_real
 
-    bag, data_dir = args
-    return compare_real(bag, data_dir=data_dir, return_frames=True)
+    bag, data_dir, relaxation = args
+    return compare_real(
+        bag, data_dir=data_dir, relaxation=relaxation, return_frames=True
+    )
 
 
 def stage_compare_real(ctx: RunContext) -> dict:
@@ -38,7 +40,12 @@ def stage_compare_real(ctx: RunContext) -> dict:
     with worker_pool(workers) as pool:
         jobs = {
             name: pool.submit(
-                _compare_real_job, (ctx.data_dir / "experiments" / name, ctx.data_dir)
+                _compare_real_job,
+                (
+                    ctx.data_dir / "experiments" / name,
+                    ctx.data_dir,
+                    ctx.options.relaxation,
+                ),
             )
             for name in names
         }

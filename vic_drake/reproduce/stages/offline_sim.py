@@ -93,11 +93,12 @@ def stage_offline_sim(ctx: RunContext) -> dict:
 
     The simulated tissue is the relaxing Hunt-Crossley law
     (:data:`vic_drake.tissue.DEFAULT_RELAXATION`, identified on the real
-    palpations; the phantom's kappa is its instantaneous modulus) with the
-    phantom's beta (1.35); the estimator fits plain HC at that beta. A
-    control run on plain-HC tissue (``control_hc``) shows what the
-    relaxation changes: on its own model the estimator fits a short
-    palpation as well as a long one, so C2's fall needs the relaxation.
+    palpations, unless the options give another; the phantom's kappa is its
+    instantaneous modulus) with the phantom's beta (1.35); the estimator
+    fits plain HC at that beta. A control run on plain-HC tissue
+    (``control_hc``) shows what the relaxation changes: on its own model the
+    estimator fits a short palpation as well as a long one, so C2's fall
+    needs the relaxation.
     Besides the fits of :func:`offline_fits`, the result holds the truth
     (instantaneous and relaxed kappa, lambda), the fits' errors against it,
     and C2's metric on both tissues.
@@ -114,11 +115,10 @@ def stage_offline_sim(ctx: RunContext) -> dict:
     xy = tuple(np.array([v]) for v in SIM_PALPATION_POINT_M)
     truth = phantom.sample(*xy)
     kappa, lam = float(truth.kappa[0]), float(truth.lam[0])
-    kappa_relaxed = DEFAULT_RELAXATION.long_term_fraction * kappa
+    relaxation = ctx.options.relaxation or DEFAULT_RELAXATION
+    kappa_relaxed = relaxation.long_term_fraction * kappa
     run = dict(freqs=freqs, duration=duration)
-    logs = _simulate(
-        ctx, phantom, truth, xy, relaxation=DEFAULT_RELAXATION, tag="", **run
-    )
+    logs = _simulate(ctx, phantom, truth, xy, relaxation=relaxation, tag="", **run)
     out = offline_fits(ctx, logs, "sim")
     out["truth"] = {
         "kappa": kappa,
@@ -126,8 +126,8 @@ def stage_offline_sim(ctx: RunContext) -> dict:
         "lam": lam,
         "tissue_law": "relaxing",
         "relaxation": {
-            "fractions": list(DEFAULT_RELAXATION.fractions),
-            "time_constants_s": list(DEFAULT_RELAXATION.time_constants_s),
+            "fractions": list(relaxation.fractions),
+            "time_constants_s": list(relaxation.time_constants_s),
         },
     }
     fits = {n: c.hunt_crossley[BEST_BETA] for n, c in out["comparisons"].items()}

@@ -27,7 +27,14 @@ QUICK_APPROACH_Z_M = 0.11
 QUICK_SCAN_M = 0.05
 
 
-def scan_scenario(controller: str, *, disturbed: bool, phantom_kind: str, quick: bool):
+def scan_scenario(
+    controller: str,
+    *,
+    disturbed: bool,
+    phantom_kind: str,
+    quick: bool,
+    relaxation=None,
+):
     """The scenario of one of the paper's scans (nominal or disturbed).
 
     ``diagrams/nominal_<controller>_synthetic.yaml`` (the real rig's scan and
@@ -35,7 +42,8 @@ def scan_scenario(controller: str, *, disturbed: bool, phantom_kind: str, quick:
     requested phantom, with :func:`vic_drake.experiments.disturbance_lifts`
     as the disturbance.
     Quick mode shortens the approach and the scan (QUICK_* constants) and
-    has one disturbance event instead of two.
+    has one disturbance event instead of two. ``relaxation`` (a
+    RelaxationParams) replaces the relaxing tissue's default branches.
     """
     # Function-local: the experiments and the scenario pull in pydrake (heavy).
     from vic_drake.experiments import disturbance_lifts, load_diagram, scan_start_s
@@ -57,6 +65,13 @@ def scan_scenario(controller: str, *, disturbed: bool, phantom_kind: str, quick:
             lifts=disturbance_lifts(scan_start_s(traj), events=1 if quick else 2)
         )
     cond = "disturbance" if disturbed else "nominal"
+    station = base.station
+    if relaxation is not None:
+        station = replace(
+            station,
+            tissue_relaxation_fractions=list(relaxation.fractions),
+            tissue_relaxation_time_constants_s=list(relaxation.time_constants_s),
+        )
     return replace(
         base,
         name=f"{cond}_{controller.replace('-', '_')}_{phantom_kind}",
@@ -65,6 +80,7 @@ def scan_scenario(controller: str, *, disturbed: bool, phantom_kind: str, quick:
         phantom=replace(base.phantom, kind=phantom_kind),
         trajectory=traj,
         disturbance=disturbance,
+        station=station,
     )
 
 
@@ -102,6 +118,7 @@ def stage_scans(ctx: RunContext) -> dict:
             disturbed=key[0] == "disturbance",
             phantom_kind=ctx.phantom_kind,
             quick=ctx.options.quick,
+            relaxation=ctx.options.relaxation,
         )
         for key in runs
     }
