@@ -54,6 +54,8 @@ def test_compare_real_reports_the_motion_and_contact_loss(
     for key in MOTION_KEYS:
         assert key in out, key
     assert out["phantom_motion_replayed"] is replayed
+    # "auto": one lateral pass when the motion is replayed, none otherwise.
+    assert out["lateral_passes"] == (1 if replayed else 0)
     assert out["phantom_motion_reference"] == reference
     assert out["phantom_motion_max_mm"] >= 0 and math.isfinite(
         out["phantom_motion_max_mm"]

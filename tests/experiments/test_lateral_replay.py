@@ -9,6 +9,7 @@ from vic_drake.experiments.lateral_replay import (
     check_lateral_passes,
     corrected_waypoints,
     lateral_rms_mm,
+    resolve_lateral_passes,
 )
 
 
@@ -74,6 +75,16 @@ def test_the_lateral_rms_is_the_horizontal_distance():
 def test_bad_pass_counts_are_refused(bad):
     with pytest.raises(VicDrakeError, match="lateral_passes"):
         check_lateral_passes(bad)
+
+
+def test_auto_runs_one_pass_only_when_the_motion_is_replayed():
+    assert check_lateral_passes("auto") == "auto"
+    assert resolve_lateral_passes("auto", replayed=True) == 1
+    assert resolve_lateral_passes("auto", replayed=False) == 0
+    assert resolve_lateral_passes(2, replayed=False) == 2
+    assert resolve_lateral_passes(0, replayed=True) == 0
+    with pytest.raises(VicDrakeError, match="lateral_passes"):
+        resolve_lateral_passes("Auto", replayed=True)
 
 
 def test_non_finite_tip_positions_are_refused():

@@ -36,19 +36,20 @@ def _positive(value: str, option: str) -> float:
     return v
 
 
-def _count(value: str) -> int:
-    """--lateral-passes: an integer from 0 to MAX_LATERAL_PASSES."""
+def _count(value: str) -> int | str:
+    """--lateral-passes: an integer from 0 to MAX_LATERAL_PASSES, or "auto"."""
     from vic_drake.experiments.lateral_replay import (
+        AUTO,
         MAX_LATERAL_PASSES,
         check_lateral_passes,
     )
 
     try:
-        return check_lateral_passes(int(value))
+        return check_lateral_passes(AUTO if value == AUTO else int(value))
     except (ValueError, VicDrakeError):
         raise VicDrakeError(
-            f"--lateral-passes takes an integer from 0 to {MAX_LATERAL_PASSES}; "
-            f"got {value!r}"
+            f"--lateral-passes takes an integer from 0 to {MAX_LATERAL_PASSES} "
+            f"or '{AUTO}'; got {value!r}"
         ) from None
 
 
@@ -155,7 +156,8 @@ def register(subparsers) -> None:
         "--lateral-passes",
         metavar="N",
         default=None,
-        help="rerun the scan N times (0-3, default 0), each with the target moved "
+        help="rerun the scan N times (0-3, or 'auto', the default: 1 when the "
+        "phantom's motion is replayed, else 0), each with the target moved "
         "by the previous run's lateral error against the real tip, so the "
         "simulated tip crosses the map where the real one did",
     )
@@ -221,7 +223,7 @@ def run_compare_real(args: argparse.Namespace) -> int:
     offset = (
         None if args.surface_offset is None else _surface_offset(args.surface_offset)
     )
-    passes = 0 if args.lateral_passes is None else _count(args.lateral_passes)
+    passes = "auto" if args.lateral_passes is None else _count(args.lateral_passes)
     relaxation = None if args.relaxation is None else parse_relaxation(args.relaxation)
     # Output paths are checked before simulating: a bad one fails now.
     if args.out:

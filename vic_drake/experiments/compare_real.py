@@ -26,9 +26,11 @@ from vic_drake.analysis.phantom_motion import (
 from vic_drake.analysis.real_comparison import compare_contact_loss, compare_with_real
 from vic_drake.errors import VicDrakeError
 from vic_drake.experiments.lateral_replay import (
+    AUTO,
     check_lateral_passes,
     corrected_waypoints,
     lateral_rms_mm,
+    resolve_lateral_passes,
 )
 from vic_drake.experiments.real_logs import (
     REAL_SCAN_FORCE_DELAY_S,
@@ -90,7 +92,7 @@ def compare_real(
     tissue_law: str | None = None,
     relaxation: RelaxationParams | None = None,
     surface_offset: float | str | None = None,
-    lateral_passes: int = 0,
+    lateral_passes: int | str = AUTO,
     progress=None,
     return_frames: bool = False,
 ):
@@ -111,12 +113,13 @@ def compare_real(
     :data:`~vic_drake.experiments.surface_calibration.DEFAULT_SURFACE_OFFSET`
     (:func:`~vic_drake.experiments.surface_calibration.surface_calibration`);
     the controller keeps reading the published map.
-    ``lateral_passes`` (0 to 3, default 0: one run, as before) reruns the
-    scan that many times, each with the target moved by the previous run's
-    lateral error against the real tip
+    ``lateral_passes`` (0 to 3, or "auto", the default: one when the motion
+    is replayed, else none) reruns the scan that many times, each with the
+    target moved by the previous run's lateral error against the real tip
     (:func:`~vic_drake.experiments.lateral_replay.corrected_waypoints`), so the
-    simulated tip crosses the map where the real one did; the metrics are
-    those of the last run.
+    simulated tip crosses the map where the real one did and the replayed
+    surface, measured under the real tip, is the one under it; the metrics
+    are those of the last run.
 
     Returns:
         dict with the contract keys controller, duration_s, force_rmse_N,
@@ -141,9 +144,9 @@ def compare_real(
         ``_speed_mm_per_s``) (None when the log holds none); with a profile
         (source "first contact + lift-off") ``surface_profile_x_m`` and
         ``surface_profile_offset_mm`` (its two anchors; ``surface_offset_mm``
-        is then their mean), else None. ``lateral_passes`` and
-        ``lateral_rms_mm`` (per run, the RMS horizontal distance between the
-        tips over the real scan window) are appended.
+        is then their mean), else None. ``lateral_passes`` (the number run)
+        and ``lateral_rms_mm`` (per run, the RMS horizontal distance between
+        the tips over the real scan window) are appended.
         With ``return_frames``: (dict, sim DataFrame, real canonical DataFrame).
     """
     bag = Path(bag_dir)
@@ -201,6 +204,7 @@ def compare_real(
         phantom = with_surface_profile(published, profile["x_m"], profile["offset_m"])
     motion, table, surface_error = phantom_replay(bag, real, phantom)
     replay = bool(table)
+    lateral_passes = resolve_lateral_passes(lateral_passes, replayed=replay)
     disturbance = DisturbanceConfig(table=table) if replay else None
     lift_m = motion["phantom_lift_m"].to_numpy()
     motion_info = {

@@ -24,20 +24,38 @@ LATERAL_PERIOD_S = 0.02
 LATERAL_SMOOTH_S = 0.2
 #: Most lateral passes compare-real accepts (each one is a full simulation).
 MAX_LATERAL_PASSES = 3
+#: compare-real's default: one pass when the phantom's motion is replayed
+#: (it was measured under the real tip, so the simulated tip must be there
+#: for the replayed surface to be the one under it), none otherwise.
+AUTO = "auto"
+#: Passes "auto" runs on a replayed log.
+AUTO_PASSES_REPLAYED = 1
 
 
-def check_lateral_passes(value) -> int:
-    """The number of lateral passes, checked: an int from 0 to MAX_LATERAL_PASSES."""
+def check_lateral_passes(value) -> int | str:
+    """The number of lateral passes, checked: an int from 0 to
+    MAX_LATERAL_PASSES, or :data:`AUTO`."""
+    if value == AUTO and isinstance(value, str):
+        return AUTO
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
         raise VicDrakeError(
-            f"lateral_passes must be an integer from 0 to {MAX_LATERAL_PASSES}; "
-            f"got {value!r}"
+            f"lateral_passes must be an integer from 0 to {MAX_LATERAL_PASSES} "
+            f"or {AUTO!r}; got {value!r}"
         )
     if not 0 <= int(value) <= MAX_LATERAL_PASSES:
         raise VicDrakeError(
             f"lateral_passes must be from 0 to {MAX_LATERAL_PASSES}; got {value!r}"
         )
     return int(value)
+
+
+def resolve_lateral_passes(value, *, replayed: bool) -> int:
+    """The passes to run: ``value`` checked, :data:`AUTO` giving
+    :data:`AUTO_PASSES_REPLAYED` when the phantom's motion is replayed, else 0."""
+    value = check_lateral_passes(value)
+    if value == AUTO:
+        return AUTO_PASSES_REPLAYED if replayed else 0
+    return value
 
 
 def _smoothed(v: np.ndarray, n: int) -> np.ndarray:
