@@ -1,6 +1,8 @@
 """The closed-loop comparison: its runs' settings, the dithered truth, and a
 short scan where the dither makes the map-free controller observable."""
 
+from pathlib import Path
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -11,6 +13,7 @@ from vic_drake.experiments.online_compare import (
     DITHER_M,
     UNDITHERED_RUNS,
     comparison_scenario,
+    main,
     online_comparison,
     true_references,
 )
@@ -26,6 +29,39 @@ def test_dithered_runs_set_the_dither_and_only_online_reads_the_slope():
         assert ref.penetration_dither_m == (DITHER_M if dither else 0.0)
         assert s.online_estimator.surface_from_slope == (dither and source == "online")
     assert "online_dither" not in UNDITHERED_RUNS and "online" in UNDITHERED_RUNS
+
+
+SYNTHETIC = (
+    Path(__file__).resolve().parents[2] / "diagrams/nominal_vs_vf_synthetic.yaml"
+)
+
+
+def test_dither_frequency_reaches_the_dithered_runs_only():
+    base = Scenario()
+    unset = base.controller.reference.penetration_dither_hz
+    for run, (*_, dither) in COMPARISON_RUNS.items():
+        default = comparison_scenario(base, run).controller.reference
+        other = comparison_scenario(base, run, dither_hz=2.9).controller.reference
+        assert default.penetration_dither_hz == (DITHER_HZ if dither else unset)
+        assert other.penetration_dither_hz == (2.9 if dither else unset)
+        assert other.penetration_dither_m == default.penetration_dither_m
+
+
+@pytest.mark.parametrize(
+    "value, message",
+    [
+        ("-1", "penetration_dither_hz must be > 0; got -1.0"),
+        ("nan", "penetration_dither_hz must be finite"),
+        ("60", "at most a tenth of the control rate"),
+    ],
+)
+def test_bad_dither_frequency_is_refused_before_any_scan(value, message, capsys):
+    # Only an undithered run asked: the value is still checked, no scan runs.
+    with pytest.raises(SystemExit) as exc:
+        main([str(SYNTHETIC), "true_map", f"--dither-hz={value}"])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert "--dither-hz" in err and message in err and "Traceback" not in err
 
 
 def test_true_references_with_and_without_the_dither():

@@ -48,6 +48,7 @@ import numpy as np
 
 from vic_drake.analysis.contact import pressing_force_N, scan_window
 from vic_drake.analysis.scan_metrics import RIB_KAPPA_THRESHOLD, force_rmse_N
+from vic_drake.errors import VicDrakeError
 from vic_drake.experiments.scan_run import run_scan
 from vic_drake.scenario import Scenario
 
@@ -77,8 +78,15 @@ COMPARISON_RUNS = {
 UNDITHERED_RUNS = tuple(name for name, run in COMPARISON_RUNS.items() if not run[4])
 
 
-def comparison_scenario(base: Scenario, run: str) -> Scenario:
-    """The base VS-VF scenario set up for one run of :data:`COMPARISON_RUNS`."""
+def comparison_scenario(
+    base: Scenario, run: str, *, dither_hz: float = DITHER_HZ
+) -> Scenario:
+    """The base VS-VF scenario set up for one run of :data:`COMPARISON_RUNS`.
+
+    ``dither_hz``: the dither's frequency in the dithered runs (a
+    VicDrakeError from the scenario's validation if the controller cannot
+    take it).
+    """
     source, kappa_scale, offset, surface, dither = COMPARISON_RUNS[run]
     s = copy.deepcopy(base)
     s.name = f"{base.name}_{run}"
@@ -90,7 +98,7 @@ def comparison_scenario(base: Scenario, run: str) -> Scenario:
     s.variations.map_errors.surface_offset_m = offset
     if dither:
         s.controller.reference.penetration_dither_m = DITHER_M
-        s.controller.reference.penetration_dither_hz = DITHER_HZ
+        s.controller.reference.penetration_dither_hz = dither_hz
         if source == "online":  # The surface from the slope, no EKF surface state.
             s.online_estimator.surface_from_slope = True
             s.online_estimator.surface_walk_m_per_sqrt_s = 0.0
@@ -162,11 +170,13 @@ def online_comparison(
     runs=UNDITHERED_RUNS,
     duration_s=None,
     progress=None,
+    dither_hz: float = DITHER_HZ,
 ) -> dict:
-    """{run: scores} for each run (see the module docstring), one at a time."""
+    """{run: scores} for each run (see the module docstring), one at a time
+    (``dither_hz``: as :func:`comparison_scenario`)."""
     out = {}
     for run in runs:
-        s = comparison_scenario(base, run)
+        s = comparison_scenario(base, run, dither_hz=dither_hz)
         result = run_scan(s, phantom=phantom, duration_s=duration_s, progress=progress)
         out[run] = score_against_truth(result.df, phantom, s)
     return out
@@ -193,8 +203,10 @@ def comparison_table(scores: dict) -> str:
 
 
 def main(argv=None) -> None:
-    """``python -m vic_drake.experiments.online_compare SCENARIO [RUN ...]``:
-    prints the table (every run of :data:`COMPARISON_RUNS` by default)."""
+    """``python -m vic_drake.experiments.online_compare SCENARIO [RUN ...]
+    [--dither-hz HZ]``: prints the table (every run of
+    :data:`COMPARISON_RUNS` by default; the dithered runs at HZ, default
+    :data:`DITHER_HZ`)."""
     import argparse
 
     from vic_drake.experiments.scan_diagram import load_scenario_phantom
@@ -203,15 +215,28 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=main.__doc__)
     parser.add_argument("scenario", help="a VS-VF scenario YAML")
     parser.add_argument("runs", nargs="*", help="runs to make (default: all)")
+    parser.add_argument(
+        "--dither-hz",
+        type=float,
+        default=DITHER_HZ,
+        help=f"frequency of the dithered runs' dither, Hz (default {DITHER_HZ})",
+    )
     args = parser.parse_args(argv)
     unknown = [r for r in args.runs if r not in COMPARISON_RUNS]
     if unknown:
         parser.error(f"unknown runs {unknown}; choose from {list(COMPARISON_RUNS)}")
     base = load_scenario(args.scenario)
+    runs = tuple(args.runs) or tuple(COMPARISON_RUNS)
+    try:  # Check the frequency (even if no run is dithered) before a scan.
+        for run in (*runs, "online_dither"):
+            comparison_scenario(base, run, dither_hz=args.dither_hz)
+    except VicDrakeError as exc:
+        parser.error(f"--dither-hz {args.dither_hz!r}: {exc}")
     scores = online_comparison(
         base,
         phantom=load_scenario_phantom(base),
-        runs=tuple(args.runs) or tuple(COMPARISON_RUNS),
+        runs=runs,
+        dither_hz=args.dither_hz,
     )
     print(comparison_table(scores))
 
