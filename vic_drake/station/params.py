@@ -272,16 +272,19 @@ class StationParams:
                 f"given ({list(g)!r}, {list(tau)!r}) but tissue_law is "
                 f"{self.tissue_law!r}; they need tissue_law 'relaxing'"
             )
-        if not all(np.isfinite(v) and v >= 0.0 for v in g) or not sum(g) < 1.0:
-            raise VicDrakeError(
-                "StationParams.tissue_relaxation_fractions must be finite, >= 0 and "
-                f"sum to < 1, got {list(g)!r}"
+        # The values' rules are RelaxationParams's; its message, renamed.
+        try:
+            RelaxationParams(tuple(g), tuple(tau))
+        except VicDrakeError as err:
+            message = str(err).replace(
+                "RelaxationParams.fractions",
+                "StationParams.tissue_relaxation_fractions",
             )
-        if not all(np.isfinite(v) and v > 0.0 for v in tau):
-            raise VicDrakeError(
-                "StationParams.tissue_relaxation_time_constants_s must be finite "
-                f"and > 0 s, got {list(tau)!r}"
+            message = message.replace(
+                "RelaxationParams.time_constants_s",
+                "StationParams.tissue_relaxation_time_constants_s",
             )
+            raise VicDrakeError(message) from None
 
     @property
     def relaxation(self) -> RelaxationParams | None:
