@@ -2,14 +2,14 @@
 
 A thin LeafSystem over :mod:`vic_drake.control.references`. The references
 are cheap algebra on the current measurement, so they are computed once per
-tick in the "tick" output port with direct feedthrough (the "references"
-and "target_force" ports are slices of it: the real controller computed them
-from the same sample as its QP, and the QP and FDCC read them within the same
-tick). The periodic discrete
-update at the controller rate advances the surface-velocity filter and
-stores the tick's values, which the "force_reference", "force_min" and
-"contact" ports publish from state: what the QP used at the last tick
-(loggers read them after the tick's update without recomputing). Only CF
+tick in the "tick" output port, with direct feedthrough ("references" and
+"target_force" are slices of it: the real controller computed them from the
+same sample as its QP, and the QP and FDCC read them within the same tick).
+The periodic discrete update at the controller rate advances the
+surface-velocity filter and stores the tick's values, which the
+"force_reference", "force_min" and "contact" ports publish from state: what
+the QP used at the last tick (loggers read them after the tick's update
+without recomputing). Only CF
 has a nonzero target force; for the other controllers "target_force" is a
 constant zero, computed once. The packed "references" and "contact" layouts
 are in :mod:`vic_drake.systems.signals`.
@@ -52,7 +52,7 @@ from vic_drake.tissue.phantom import Phantom
 
 #: The map sample of a faulty tick (no lookup was made).
 _NO_SAMPLE = (math.nan, math.nan)
-#: The cached tick (one array): the references, the tick record, the new
+#: The "tick" vector (one per tick): the references, the tick record, the new
 #: surface-velocity filter state.
 _REFERENCES = slice(0, REFERENCES_SIZE)
 _RECORD = slice(REFERENCES_SIZE, REFERENCES_SIZE + TICK_RECORD_SIZE)
@@ -195,7 +195,7 @@ class ForceReferenceSystem(LeafSystem):
             self._calc_references,
             {tick_port.cache_entry().ticket()},
         )
-        # (state group, its slice of the cached tick): every group, all
+        # (state group, its slice of the tick vector): every group, all
         # written by the update.
         self._state_parts = [
             (
