@@ -107,12 +107,22 @@ def test_reference_system_ports_and_layout(phantom):
         "force_min": 3,
         "contact": len(CONTACT_FIELDS),
         "tick_record": len(TICK_RECORD_FIELDS),
+        # The references, the record, the new filter state (3 + window 10).
+        "tick": REFERENCES_SIZE + len(TICK_RECORD_FIELDS) + 13,
     }
     context = system.CreateDefaultContext()
     system.get_probe_position_input_port().FixValue(context, P_WP)
     system.get_probe_velocity_input_port().FixValue(context, V_WP)
     system.get_measured_force_input_port().FixValue(context, F_W)
     refs = system.get_references_output_port().Eval(context)
+    # The "tick" vector (what the controller Diagram hands the QP through a
+    # Demultiplexer) starts with the references, then the record.
+    whole = system.get_tick_output_port().Eval(context)
+    np.testing.assert_array_equal(whole[:REFERENCES_SIZE], refs)
+    np.testing.assert_array_equal(
+        whole[REFERENCES_SIZE : REFERENCES_SIZE + len(TICK_RECORD_FIELDS)],
+        [*P_WP, *V_WP, *F_W, KAPPA, LAM],
+    )
     expected = force_references(contact=True, kappa=KAPPA, lam=LAM, eps_dot=-V_WP[2],
                                 beta=BETA, ref=p.reference, qp=p.qp)  # fmt: skip
     np.testing.assert_allclose(

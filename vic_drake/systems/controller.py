@@ -7,10 +7,12 @@ named "variable_impedance_controller" composing
   rate, F_ref, F_min, the FDCC target force,
 - "stiffness_qp" (:class:`StiffnessQpSystem`): K (QP or constant), D,
   status, and the record of its tick ("qp_tick") the tank integrates,
-- "energy_tank" (:class:`EnergyTankSystem`): T, power, sigma, enabled
-  (its T reaches the QP through "tank_fields", a Demultiplexer),
+- "energy_tank" (:class:`EnergyTankSystem`): T, power, sigma, enabled,
 
-all at ``params.period_s`` (500 Hz by default). All four controllers (CS,
+all at ``params.period_s`` (500 Hz by default). The QP reads its references
+(the head of "force_reference"'s "tick" vector) and T (an element of the
+tank's "tank" record) through two C++ Demultiplexers, "reference_fields"
+and "tank_fields", so that neither read calls Python. All four controllers (CS,
 CF, VS-CF, VS-VF) expose the same ports; see
 :class:`vic_drake.control.params.ReferenceParams` for how each maps to
 (stiffness, target_force) of the compliance (FDCC) stage.
@@ -26,7 +28,12 @@ from vic_drake.errors import VicDrakeError
 from vic_drake.estimation.online import OnlineEstimatorParams
 from vic_drake.systems.online_estimator import OnlineEstimatorSystem
 from vic_drake.systems.references import ForceReferenceSystem
-from vic_drake.systems.signals import STATUS_FIELDS, TANK_ENERGY, TANK_FIELDS
+from vic_drake.systems.signals import (
+    REFERENCES_SIZE,
+    STATUS_FIELDS,
+    TANK_ENERGY,
+    TANK_FIELDS,
+)
 from vic_drake.systems.stiffness_qp import StiffnessQpSystem
 from vic_drake.systems.tank import EnergyTankSystem
 from vic_drake.tissue.phantom import Phantom
@@ -138,7 +145,16 @@ def MakeVariableImpedanceController(
     if online:
         builder.ConnectInput(index, est.GetInputPort("ft_sensor.force_W"))
 
-    builder.Connect(ref.get_references_output_port(), qp.GetInputPort("references"))
+    # The QP reads the references from the reference system's "tick" vector
+    # through a C++ Demultiplexer: no Python output callback per tick.
+    ref_fields = builder.AddNamedSystem(
+        "reference_fields",
+        Demultiplexer(
+            [REFERENCES_SIZE, ref.get_tick_output_port().size() - REFERENCES_SIZE]
+        ),
+    )
+    builder.Connect(ref.get_tick_output_port(), ref_fields.get_input_port())
+    builder.Connect(ref_fields.get_output_port(0), qp.GetInputPort("references"))
     # The QP reads T from the "tank" record through a C++ Demultiplexer: the
     # number of the tank's own "tank_energy" port, with no Python call per tick.
     tank_fields = builder.AddNamedSystem(

@@ -1,14 +1,15 @@
 """ForceReferenceSystem: contact, penetration rate and force references.
 
 A thin LeafSystem over :mod:`vic_drake.control.references`. The references
-are cheap algebra on the current measurement, so they are computed in a
-cache entry with direct feedthrough (the "references" and "target_force"
-ports: the real controller computed them from the same sample as its QP,
-and the QP and FDCC read them within the same tick). The periodic discrete
-update at the controller rate advances the surface-velocity filter and
-stores the tick's values, which the "force_reference", "force_min" and
-"contact" ports publish from state: what the QP used at the last tick
-(loggers read them after the tick's update without recomputing). Only CF
+are cheap algebra on the current measurement, so they are computed once per
+tick in the "tick" output port, with direct feedthrough ("references" and
+"target_force" are slices of it: the real controller computed them from the
+same sample as its QP, and the QP and FDCC read them within the same tick).
+The periodic discrete update at the controller rate advances the
+surface-velocity filter and stores the tick's values, which the
+"force_reference", "force_min" and "contact" ports publish from state: what
+the QP used at the last tick (loggers read them after the tick's update
+without recomputing). Only CF
 has a nonzero target force; for the other controllers "target_force" is a
 constant zero, computed once. The packed "references" and "contact" layouts
 are in :mod:`vic_drake.systems.signals`.
@@ -20,8 +21,7 @@ import copy
 import math
 
 import numpy as np
-from pydrake.common.value import AbstractValue
-from pydrake.systems.framework import BasicVector, LeafSystem, ValueProducer
+from pydrake.systems.framework import BasicVector, LeafSystem
 
 from vic_drake.control.params import ControllerParams
 from vic_drake.control.references import (
@@ -52,7 +52,7 @@ from vic_drake.tissue.phantom import Phantom
 
 #: The map sample of a faulty tick (no lookup was made).
 _NO_SAMPLE = (math.nan, math.nan)
-#: The cached tick (one array): the references, the tick record, the new
+#: The "tick" vector (one per tick): the references, the tick record, the new
 #: surface-velocity filter state.
 _REFERENCES = slice(0, REFERENCES_SIZE)
 _RECORD = slice(REFERENCES_SIZE, REFERENCES_SIZE + TICK_RECORD_SIZE)
@@ -82,6 +82,10 @@ class ForceReferenceSystem(LeafSystem):
             :data:`vic_drake.systems.signals.REFERENCES_SIZE` and the
             ``REF_*`` slices), read by StiffnessQpSystem in one port
             evaluation.
+        tick (13 + 11 + filter size): the references, then the tick
+            record (as "tick_record"), then the new surface-velocity
+            filter state: what the update stores. The controller Diagram
+            splits it with a C++ Demultiplexer for the QP.
     Output ports (state: the values of the last tick):
         force_reference (3): F_ref, N (sensor convention).
         force_min (3): F_min, N.
@@ -155,8 +159,10 @@ class ForceReferenceSystem(LeafSystem):
         filter_state = surface_velocity_initial_state(ref.surface_velocity_window)
         self._filter_index = self.DeclareDiscreteState(filter_state)
         self.DeclarePeriodicDiscreteUpdateEvent(self._dt, 0.0, self._update)
-        # The tick's values, one array (see _evaluate); with VS-VF's
-        # penetration dither they depend on the time too.
+        # The tick's values, one vector (see _evaluate): a vector output port,
+        # so that the controller Diagram can hand its references to the QP
+        # through a C++ Demultiplexer (no Python call for the QP's read). With
+        # VS-VF's penetration dither they depend on the time too.
         self._dither = ref.penetration_dither_m > 0.0
         tickets = {
             self.all_input_ports_ticket(),
@@ -164,17 +170,17 @@ class ForceReferenceSystem(LeafSystem):
         }
         if self._dither:
             tickets.add(self.time_ticket())
-        self._cache = self.DeclareCacheEntry(
-            "references",
-            ValueProducer(
-                allocate=lambda: AbstractValue.Make(object()), calc=self._calc
-            ),
-            tickets,
+        self._tick_size = _FILTER_START + len(filter_state)
+        self._tick_port = tick_port = self.DeclareVectorOutputPort(
+            "tick", self._tick_size, self._calc, tickets
         )
-        self._outputs = {}
+        self._outputs = {"tick": tick_port}
         if ref.controller == "cf":
             self._outputs["target_force"] = self.DeclareVectorOutputPort(
-                "target_force", 3, self._calc_target_force, {self._cache.ticket()}
+                "target_force",
+                3,
+                self._calc_target_force,
+                {tick_port.cache_entry().ticket()},
             )
         else:  # Zero at every tick, faulty or not.
             self._outputs["target_force"] = self.DeclareVectorOutputPort(
@@ -187,9 +193,9 @@ class ForceReferenceSystem(LeafSystem):
             "references",
             REFERENCES_SIZE,
             self._calc_references,
-            {self._cache.ticket()},
+            {tick_port.cache_entry().ticket()},
         )
-        # (state group, its slice of the cached tick): every group, all
+        # (state group, its slice of the tick vector): every group, all
         # written by the update.
         self._state_parts = [
             (
@@ -224,10 +230,10 @@ class ForceReferenceSystem(LeafSystem):
         self._safe_values = safe
 
     def _calc_references(self, context, output: BasicVector):
-        output.set_value(self._cache.Eval(context)[_REFERENCES])
+        output.set_value(self._tick_port.Eval(context)[_REFERENCES])
 
     def _calc_target_force(self, context, output: BasicVector):
-        output.set_value(self._cache.Eval(context)[REF_TARGET_FORCE])
+        output.set_value(self._tick_port.Eval(context)[REF_TARGET_FORCE])
 
     def _evaluate(self, context) -> np.ndarray:
         """The tick now, as one array: the references (``_REFERENCES``), the
@@ -286,11 +292,11 @@ class ForceReferenceSystem(LeafSystem):
             return _array([*self._safe_values, *p_WP, *v_WP, *f_W, *_NO_SAMPLE, *filt])
         return _array([*values, *p_WP, *v_WP, *f_W, kappa, lam, *filt])
 
-    def _calc(self, context, value):
-        value.set_value(self._evaluate(context))
+    def _calc(self, context, output: BasicVector):
+        output.set_value(self._evaluate(context))
 
     def _update(self, context, discrete_state):
-        tick = self._cache.Eval(context)
+        tick = self._tick_port.Eval(context)
         for view, part in self._scratch_views:
             view[:] = tick[part]
         discrete_state.SetFrom(self._scratch)
@@ -321,3 +327,6 @@ class ForceReferenceSystem(LeafSystem):
 
     def get_references_output_port(self):
         return self._outputs["references"]
+
+    def get_tick_output_port(self):
+        return self._outputs["tick"]

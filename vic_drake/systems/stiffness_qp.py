@@ -138,18 +138,26 @@ class StiffnessQpSystem(LeafSystem):
         self._state_groups = tuple(
             self._index[name] for name in ("stiffness", "damping", "qp_tick", "status")
         )
+        # Scratch for the update: every group is written through these numpy
+        # views, then copied into the update's result with one SetFrom (four
+        # get_mutable_value calls cost more). Only the update uses it, and it
+        # overwrites all of it each time.
+        self._scratch = self.AllocateDiscreteVariables()
+        self._scratch_views = tuple(
+            self._scratch.get_mutable_value(index) for index in self._state_groups
+        )
         self.DeclarePeriodicDiscreteUpdateEvent(self._dt, 0.0, self._update)
 
     def _update(self, context, discrete_state):
         # On entry discrete_state holds the current state (a LeafSystem copies
-        # it in before calling an update handler): K is read there, and the
-        # fallback count is incremented in place.
+        # it in before calling an update handler): K and the fallback count
+        # are read there.
         p_WP = self._in_position.Eval(context).tolist()
         v_WP = self._in_velocity.Eval(context).tolist()
         x_d = self._in_target.Eval(context).tolist()
         refs = self._in_references.Eval(context).tolist()
         energy = self._in_energy.Eval(context).tolist()[0]
-        i_k, i_d, i_tick, i_status = self._state_groups
+        i_k, _, _, i_status = self._state_groups
         k_prev = discrete_state.value(i_k).tolist()
         zeta2 = 2.0 * self._zeta
         d_used = (
@@ -182,32 +190,33 @@ class StiffnessQpSystem(LeafSystem):
                 k = sol.stiffness
                 solve_time = sol.solve_time_s
                 ok = sol.success
-        # Written through numpy views of discrete_state: an element store costs
-        # far less than converting a Python sequence in set_value.
+        # Written through numpy views of the scratch (an element store costs
+        # far less than converting a Python sequence), then one SetFrom.
+        out_k, out_d, out_tick, status = self._scratch_views
         k0, k1, k2 = k
-        out = discrete_state.get_mutable_value(i_k)
-        out[0], out[1], out[2] = k0, k1, k2
-        out = discrete_state.get_mutable_value(i_d)
-        out[0] = zeta2 * math.sqrt(max(k0, 0.0))
-        out[1] = zeta2 * math.sqrt(max(k1, 0.0))
-        out[2] = zeta2 * math.sqrt(max(k2, 0.0))
+        out_k[0], out_k[1], out_k[2] = k0, k1, k2
+        out_d[0] = zeta2 * math.sqrt(max(k0, 0.0))
+        out_d[1] = zeta2 * math.sqrt(max(k1, 0.0))
+        out_d[2] = zeta2 * math.sqrt(max(k2, 0.0))
         tick = self._tick_template.copy()
         tick[QP_TICK_POSITION_ERROR] = e
         tick[QP_TICK_VELOCITY_ERROR] = e_dot
         tick[QP_TICK_STIFFNESS] = k
         tick[QP_TICK_DAMPING_USED] = d_used
-        discrete_state.get_mutable_value(i_tick)[:] = tick
-        status = discrete_state.get_mutable_value(i_status)
+        out_tick[:] = tick
+        fallbacks = discrete_state.value(i_status)[STATUS_FALLBACK_COUNT]
         if ok:
             status[STATUS_QP_OK] = 1.0
+            status[STATUS_FALLBACK_COUNT] = fallbacks
         else:
             status[STATUS_QP_OK] = 0.0
-            status[STATUS_FALLBACK_COUNT] += 1.0
+            status[STATUS_FALLBACK_COUNT] = fallbacks + 1.0
         status[_STATUS_FAULT] = 1.0 if fault else 0.0
         status[_STATUS_IN_CONTACT] = 0.0 if fault else refs[REF_IN_CONTACT]
         status[_STATUS_SOLVE_TIME] = solve_time
         pen = refs[REF_PENETRATION]
         status[_STATUS_PENETRATION] = pen if math.isfinite(pen) else 0.0
+        discrete_state.SetFrom(self._scratch)
 
     def get_stiffness_output_port(self):
         return self._out["stiffness"]

@@ -106,8 +106,10 @@ class EnergyTankSystem(LeafSystem):
 
     def _calc_tank(self, context, output: BasicVector):
         energy, power, sigma, enabled = self._step(context)
-        # In the order of TANK_FIELDS.
-        output.SetFromVector((energy, power, sigma, 1.0 if enabled else 0.0))
+        # In the order of TANK_FIELDS, through a numpy view (SetFromVector
+        # converts a Python sequence: costlier).
+        out = output.get_mutable_value()
+        out[0], out[1], out[2], out[3] = energy, power, sigma, 1.0 if enabled else 0.0
 
     # "tank_energy" and the update read the cached "tank" output: one tank
     # step per tick.
