@@ -106,8 +106,7 @@ def _fit_relaxation(args) -> int:
     out = {
         "beta": fit.beta,
         "relaxation": {
-            "fractions": list(rel.fractions),
-            "time_constants_s": list(rel.time_constants_s),
+            **rel.as_dict(),
             "long_term_fraction": rel.long_term_fraction,
         },
         "fitted": {

@@ -236,10 +236,7 @@ def compare_real(
     if tissue_law is not None:
         scenario.station.tissue_law = tissue_law
     if relaxation is not None:
-        scenario.station.tissue_relaxation_fractions = list(relaxation.fractions)
-        scenario.station.tissue_relaxation_time_constants_s = list(
-            relaxation.time_constants_s
-        )
+        scenario.station = scenario.station.with_relaxation(relaxation)
     if surface["offset_m"] != 0.0 and profile is None:
         # The controller reads the published map, as the real one read its own.
         scenario.variations.map_errors.surface_offset_m = -surface["offset_m"]
@@ -315,10 +312,7 @@ def compare_real(
     out["lateral_passes"] = lateral_passes
     out["lateral_rms_mm"] = lateral_rms
     if relaxation is not None:
-        out["tissue_relaxation"] = {
-            "fractions": list(relaxation.fractions),
-            "time_constants_s": list(relaxation.time_constants_s),
-        }
+        out["tissue_relaxation"] = relaxation.as_dict()
     if return_frames:
         return out, result.df, real
     return out

@@ -124,7 +124,8 @@ def hand_moved_roundtrip(
     if keep:
         truth.df.to_pickle(out_dir / f"hand_{log}_{seed}_truth.pkl")
         sim.to_pickle(out_dir / f"hand_{log}_{seed}_replay.pkl")
-    # The estimate and the replay against the truth, on the bag's clock.
+    # The estimate (against the published map; compare-real keeps its own)
+    # and the replay against the truth, on the bag's clock.
     t = real["t_s"].to_numpy()
     lift = np.interp(
         t, truth.df["t_s"].to_numpy(), truth.df["phantom_lift_m"].to_numpy()

@@ -35,7 +35,7 @@ AUTO_PASSES_REPLAYED = 1
 def check_lateral_passes(value) -> int | str:
     """The number of lateral passes, checked: an int from 0 to
     MAX_LATERAL_PASSES, or :data:`AUTO`."""
-    if value == AUTO and isinstance(value, str):
+    if isinstance(value, str) and value == AUTO:
         return AUTO
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
         raise VicDrakeError(

@@ -14,7 +14,7 @@ Every message names the field and the value.
 the field types at run time.)
 """
 
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 from pydrake.math import RigidTransform, RotationMatrix
@@ -285,6 +285,14 @@ class StationParams:
                 "StationParams.tissue_relaxation_time_constants_s",
             )
             raise VicDrakeError(message) from None
+
+    def with_relaxation(self, relaxation: RelaxationParams) -> "StationParams":
+        """A copy whose relaxing tissue has ``relaxation``'s branches."""
+        return replace(
+            self,
+            tissue_relaxation_fractions=list(relaxation.fractions),
+            tissue_relaxation_time_constants_s=list(relaxation.time_constants_s),
+        )
 
     @property
     def relaxation(self) -> RelaxationParams | None:

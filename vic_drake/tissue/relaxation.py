@@ -89,6 +89,13 @@ class RelaxationParams:
         """g_inf = 1 - sum g_i: relaxed kappa / instantaneous kappa."""
         return 1.0 - float(sum(self.fractions))
 
+    def as_dict(self) -> dict:
+        """{"fractions": [...], "time_constants_s": [...]} (JSON-ready)."""
+        return {
+            "fractions": list(self.fractions),
+            "time_constants_s": list(self.time_constants_s),
+        }
+
     def relaxation_function(self, t_s) -> np.ndarray:
         """G(t) = g_inf + sum_i g_i exp(-t / tau_i): the force after a unit step."""
         t = np.asarray(t_s, float)[..., None]

@@ -125,10 +125,7 @@ def stage_offline_sim(ctx: RunContext) -> dict:
         "kappa_relaxed": kappa_relaxed,
         "lam": lam,
         "tissue_law": "relaxing",
-        "relaxation": {
-            "fractions": list(relaxation.fractions),
-            "time_constants_s": list(relaxation.time_constants_s),
-        },
+        "relaxation": relaxation.as_dict(),
     }
     fits = {n: c.hunt_crossley[BEST_BETA] for n, c in out["comparisons"].items()}
     out["estimation_error"] = _errors(fits, kappa, kappa_relaxed, lam)

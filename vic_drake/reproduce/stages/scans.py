@@ -67,11 +67,7 @@ def scan_scenario(
     cond = "disturbance" if disturbed else "nominal"
     station = base.station
     if relaxation is not None:
-        station = replace(
-            station,
-            tissue_relaxation_fractions=list(relaxation.fractions),
-            tissue_relaxation_time_constants_s=list(relaxation.time_constants_s),
-        )
+        station = station.with_relaxation(relaxation)
     return replace(
         base,
         name=f"{cond}_{controller.replace('-', '_')}_{phantom_kind}",
