@@ -12,11 +12,20 @@ from tests.estimation.online.hc_data import hc_palpation
 from vic_drake.errors import VicDrakeError
 from vic_drake.estimation.online import (
     OnlineEstimatorParams,
+    convergence_time_s,
     ekf_initial_state,
     ekf_layout,
     rls_initial_state,
     rls_step,
     run_online,
+)
+from vic_drake.estimation.online.core import (
+    AUX_SIZE,
+    CLIP_START,
+    N_CLIPPED,
+    T_UPDATE,
+    initial_state,
+    record_clip,
 )
 
 METHODS = ("rls", "ekf")
@@ -60,6 +69,47 @@ def test_survives_nan_spikes_and_dropouts(method):
     assert trace.kappa[-1] == pytest.approx(kappa, rel=0.03)
 
 
+def _stepped_palpation(kappa_after: float, step_s: float = 5.0):
+    """hc_palpation at 4000 / 32000 that becomes kappa_after, 8 x that at step_s."""
+    t, z, v, f, s = hc_palpation(4000.0, 32000.0, seed=2)
+    f_after = hc_palpation(kappa_after, 8.0 * kappa_after, seed=2)[3]
+    return t, z, v, np.where(t >= step_s, f_after, f), s
+
+
+@pytest.mark.parametrize("method", METHODS)
+@pytest.mark.parametrize("kappa_after", [8000.0, 12000.0])
+def test_follows_a_step_in_the_tissue(method, kappa_after):
+    # The probe moves onto tissue 2-3 x as stiff. Every innovation is then
+    # beyond the gate; without the covariance reset the clipped steps left
+    # the RLS 30-50 % low 5 s later and took the EKF 0.6 s.
+    t, z, v, f, s = _stepped_palpation(kappa_after)
+    trace = run_online(t, z, v, f, s, OnlineEstimatorParams(method=method))
+    after = trace.in_contact & (t >= 5.0)
+    assert convergence_time_s(t, trace.kappa, kappa_after, after) <= 0.2
+    assert trace.kappa[-1] == pytest.approx(kappa_after, rel=0.03)
+
+
+def test_clip_reset_zero_keeps_the_gate_alone():
+    t, z, v, f, s = _stepped_palpation(8000.0)
+    params = OnlineEstimatorParams(method="rls", clip_reset_s=0.0)
+    trace = run_online(t, z, v, f, s, params)
+    # Gated for the whole second half: far from 8000 at the end.
+    assert trace.kappa[-1] < 0.8 * 8000.0
+    assert trace.final_state[N_CLIPPED] > 1000
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_far_prior_stiff_tissue(method):
+    # 7.5 x the prior kappa (4000): the first updates overshoot into the
+    # variance the prior allowed, the rest are clipped; before the reset the
+    # RLS ended 23 % low after 10 s and the EKF took 0.34 s.
+    kappa, lam = 30000.0, 240000.0
+    t, z, v, f, s = hc_palpation(kappa, lam, seed=1)
+    trace = run_online(t, z, v, f, s, OnlineEstimatorParams(method=method))
+    assert convergence_time_s(t, trace.kappa, kappa, trace.in_contact) <= 0.2
+    assert trace.kappa[-1] == pytest.approx(kappa, rel=0.02)
+
+
 @pytest.mark.parametrize("method", METHODS)
 def test_holds_through_contact_loss_and_recontact(method):
     kappa, lam = 3000.0, 25000.0
@@ -100,7 +150,7 @@ def test_ekf_layout_and_beta_state():
         method="ekf", estimate_beta=True, surface_walk_m_per_sqrt_s=1e-3
     )
     assert ekf_layout(p) == (4, 2, 3)
-    assert len(ekf_initial_state(p)) == 9 + 4 + 16
+    assert len(ekf_initial_state(p)) == AUX_SIZE + 4 + 16
     t, z, v, f, s = hc_palpation(4000.0, 30000.0, beta=1.35, seed=7)
     trace = run_online(t, z, v, f, s, p)
     assert np.all(np.isfinite(trace.values[:, :5]))
@@ -123,6 +173,7 @@ def test_step_is_pure():
         ("kappa_prior", -1.0),
         ("gate_sigma", math.nan),
         ("max_rel_change", 1.0),
+        ("clip_reset_s", -0.01),
     ],
 )
 def test_params_reject_bad_values(field, value):
@@ -135,3 +186,22 @@ def test_params_reject_bad_values(field, value):
 def test_estimate_beta_needs_ekf():
     with pytest.raises(VicDrakeError, match="estimate_beta"):
         OnlineEstimatorParams(method="rls", estimate_beta=True)
+
+
+def test_a_clipped_run_is_timed_within_contact():
+    aux = initial_state([1.0, 1.0], [0.25, 0.25])[:AUX_SIZE]
+    aux[T_UPDATE] = 0.0
+    # Two clipped updates 1 s apart (a contact loss between): no reset.
+    assert not record_clip(aux, True, 0.002, 0.05, 0.02)
+    aux[T_UPDATE] = 0.002
+    assert not record_clip(aux, True, 1.002, 0.05, 0.02)
+    # Clipped every 2 ms from there: the reset comes 50 ms into the run.
+    resets = []
+    for k in range(1, 40):
+        aux[T_UPDATE] = 1.002 + 0.002 * (k - 1)
+        resets.append(record_clip(aux, True, 1.002 + 0.002 * k, 0.05, 0.02))
+    assert resets.index(True) == 24 and resets.count(True) == 1
+    # An unclipped update ends the run.
+    aux[T_UPDATE] += 0.002
+    assert not record_clip(aux, False, aux[T_UPDATE] + 0.002, 0.05, 0.02)
+    assert math.isnan(aux[CLIP_START])

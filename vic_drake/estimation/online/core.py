@@ -17,7 +17,10 @@ Per sample (:func:`prepare`):
 - the surface rate s_dot is a first-order low-pass of its finite
   differences, restarted after a gap longer than ``max_gap_s``;
 - contact: force above ``contact_threshold_N`` and penetration above
-  ``min_penetration_m``; only samples in contact update x.
+  ``min_penetration_m``; only samples in contact update x;
+- innovations are clipped at ``gate_sigma`` (spikes); when every update
+  has been clipped for ``clip_reset_s``, P returns to the prior
+  (:func:`record_clip`).
 
 All arithmetic is on Python floats: the filters are 2 to 4 states, where
 numpy's per-call overhead would dominate a tick.
@@ -40,7 +43,8 @@ N_UPDATES = 5  # samples that updated x
 N_FAULTS = 6  # non-finite or out-of-order samples
 N_CLIPPED = 7  # updates whose innovation was clipped (spikes, big changes)
 T_UPDATE = 8  # time of the last update, s (NaN before the first)
-AUX_SIZE = 9
+CLIP_START = 9  # time of the first of the clipped updates in a row, s (NaN: none)
+AUX_SIZE = 10
 
 #: Fields of the estimator's outputs, in order (:class:`Estimate`).
 OUTPUT_FIELDS = (
@@ -88,7 +92,7 @@ class Sample(NamedTuple):
 def initial_state(x0: list[float], p0_diag: list[float]) -> list[float]:
     """A fresh state: no sample seen, x = x0, P = diag(p0_diag)."""
     n = len(x0)
-    aux = [math.nan, math.nan, math.nan, 0.0, 0.0, 0.0, 0.0, 0.0, math.nan]
+    aux = [math.nan, math.nan, math.nan, 0.0, 0.0, 0.0, 0.0, 0.0, math.nan, math.nan]
     P = [0.0] * (n * n)
     for i in range(n):
         P[i * n + i] = float(p0_diag[i])
@@ -182,6 +186,39 @@ def scalar_update(
     return clipped
 
 
+def record_clip(
+    aux: list[float], clipped: bool, t: float, reset_s: float, max_gap_s: float
+) -> bool:
+    """Counts a clipped update (in ``aux``); True when P must return to the prior.
+
+    Call before ``aux[T_UPDATE]`` takes ``t``. A spike is one sample or a
+    few. When every update has been clipped for ``reset_s`` seconds (a run
+    that a gap longer than ``max_gap_s`` between updates, such as a contact
+    loss, restarts), the data disagree with the estimate and its
+    covariance, not with a spike: the caller then resets the covariance to
+    the prior (:func:`reset_covariance`; the estimate is kept), so that the
+    data move the estimate again. ``reset_s`` 0: never.
+    """
+    if not clipped:
+        aux[CLIP_START] = math.nan
+        return False
+    aux[N_CLIPPED] += 1.0
+    if math.isnan(aux[CLIP_START]) or not t - aux[T_UPDATE] <= max_gap_s:
+        aux[CLIP_START] = t
+    if reset_s > 0.0 and t - aux[CLIP_START] >= reset_s:
+        aux[CLIP_START] = math.nan
+        return True
+    return False
+
+
+def reset_covariance(P: list[float], prior_var: list[float]) -> None:
+    """P = diag(prior_var), in place."""
+    n = len(prior_var)
+    P[:] = [0.0] * (n * n)
+    for i in range(n):
+        P[i * n + i] = prior_var[i]
+
+
 def cap_variances(P: list[float], caps: list[float]) -> None:
     """Scales row and column i so that P_ii <= caps[i] (keeps P PSD), in place."""
     n = len(caps)
@@ -236,6 +273,8 @@ __all__ = [
     "initial_state",
     "make_estimate",
     "prepare",
+    "record_clip",
+    "reset_covariance",
     "scalar_update",
     "unpack",
 ]

@@ -16,7 +16,9 @@ surface latched at first contact, is estimated too) and beta (when
 linearised at the current state. Prediction adds the random-walk variance
 of the time since the last update (a contact loss of a few seconds lets
 the estimate move again at re-contact), capped at the prior variance.
-Faulty samples and samples out of contact change nothing.
+Faulty samples and samples out of contact change nothing. Clipped
+innovations and the covariance reset after ``clip_reset_s`` of them in a
+row: as the RLS (:func:`~vic_drake.estimation.online.core.record_clip`).
 
 With ``surface_from_slope`` (:func:`ekf_slope_step`) a fit of the tissue's
 local slope under the moving tip (:mod:`vic_drake.estimation.online.slope`)
@@ -32,7 +34,6 @@ import math
 from vic_drake.estimation.online.core import (
     AUX_SIZE,
     IN_CONTACT,
-    N_CLIPPED,
     N_UPDATES,
     S_PREV,
     T_UPDATE,
@@ -41,6 +42,8 @@ from vic_drake.estimation.online.core import (
     initial_state,
     make_estimate,
     prepare,
+    record_clip,
+    reset_covariance,
     scalar_update,
     unpack,
 )
@@ -133,8 +136,11 @@ def ekf_step(
             h[i_s] = stiff * beta * eps ** (beta - 1.0) * _MM
         if i_b is not None:
             h[i_b] = predicted * math.log(eps)
-        if scalar_update(x, P, h, force - predicted, p.noise_std_N**2, p.gate_sigma):
-            aux[N_CLIPPED] += 1.0
+        clipped = scalar_update(
+            x, P, h, force - predicted, p.noise_std_N**2, p.gate_sigma
+        )
+        if record_clip(aux, clipped, t, p.clip_reset_s, p.max_gap_s):
+            reset_covariance(P, _prior(p)[1])
         bound_parameters(x, p.max_rel_change)
         if i_b is not None:
             x[i_b] = min(max(x[i_b], 0.5), 3.0)

@@ -66,6 +66,10 @@ class OnlineEstimatorParams:
         gate_sigma: innovations are clipped at this many predicted
             standard deviations (a spike moves the estimate by a bounded
             step, a real change still gets through).
+        clip_reset_s: when every update has been clipped for this long, s,
+            the covariance returns to the prior (the tissue changed faster
+            than the covariance allowed, or the prior was far off); 0:
+            never.
         valid_rel_std: the estimate is flagged valid in contact once the
             std of kappa is below this fraction of kappa_hat.
         max_gap_s: a sample more than this after the previous one restarts
@@ -106,6 +110,7 @@ class OnlineEstimatorParams:
     contact_threshold_N: float = CONTACT_THRESHOLD_N
     min_penetration_m: float = 0.5e-3
     gate_sigma: float = 4.0
+    clip_reset_s: float = 0.05
     valid_rel_std: float = 0.1
     max_gap_s: float = 0.02
     surface_rate_time_constant_s: float = 0.02
@@ -140,6 +145,7 @@ class OnlineEstimatorParams:
             "contact_threshold_N",
             "min_penetration_m",
             "surface_rate_time_constant_s",
+            "clip_reset_s",
         ):
             _number(name, getattr(self, name), low=0.0)
         _number("gate_sigma", self.gate_sigma, low=0.0, low_open=True)

@@ -11,7 +11,10 @@ divided by it before each update. A direction the data does not excite
 (lam, when the probe barely moves) would then grow without bound
 (wind-up); each variance is capped at its prior value instead. Out of
 contact, and on a faulty sample, nothing is forgotten and nothing learnt:
-the estimate is held. Shared bookkeeping (faults, surface, contact) in
+the estimate is held. Innovations beyond ``gate_sigma`` are clipped (spikes);
+after ``clip_reset_s`` of clipped updates in a row the covariance returns to
+the prior (:func:`~vic_drake.estimation.online.core.record_clip`). Shared
+bookkeeping (faults, surface, contact) in
 :mod:`vic_drake.estimation.online.core`.
 
 ``rls_initial_state(params)`` and ``rls_step(state, t, z, z_dot, force,
@@ -25,7 +28,6 @@ import math
 
 from vic_drake.estimation.online.core import (
     IN_CONTACT,
-    N_CLIPPED,
     N_UPDATES,
     S_PREV,
     T_UPDATE,
@@ -35,6 +37,8 @@ from vic_drake.estimation.online.core import (
     initial_state,
     make_estimate,
     prepare,
+    record_clip,
+    reset_covariance,
     scalar_update,
     unpack,
 )
@@ -93,8 +97,9 @@ def rls_step(
             cap = p.prior_rel_std**2
             cap_variances(P, [cap, cap])
         innovation = force - (h[0] * x[0] + h[1] * x[1])
-        if scalar_update(x, P, h, innovation, p.noise_std_N**2, p.gate_sigma):
-            aux[N_CLIPPED] += 1.0
+        clipped = scalar_update(x, P, h, innovation, p.noise_std_N**2, p.gate_sigma)
+        if record_clip(aux, clipped, t, p.clip_reset_s, p.max_gap_s):
+            reset_covariance(P, [p.prior_rel_std**2] * RLS_SIZE)
         bound_parameters(x, p.max_rel_change)
         aux[N_UPDATES] += 1.0
         aux[T_UPDATE] = t
