@@ -14,6 +14,8 @@ Sections (``--section``, default all):
   windows (1 and 2 s, one and two cycles) as a ratio to the whole-log fit,
   and from when each stays within 10 % of it: what an estimator of the
   current tissue can reach at best.
+- ``trajectory``: on the 1 Hz log, kappa_hat of the RLS, the EKF and the
+  EKF with a 1 mm/sqrt(s) surface walk against the trailing 2 s fit.
 - ``creep``: per palpation log, the cycle-mean tip height's sink at a
   constant target, as a rate and as a random walk (m / sqrt(s)).
 - ``scaled``: the palpation logs with the force scaled by 0.2 ... 4 (kappa
@@ -149,6 +151,53 @@ CREEP_SPANS = {
 }
 
 
+def trajectory_section(data_dir, log="palpation/test_soft_1hz") -> None:
+    """kappa_hat / whole-log fit against the trailing 2 s fit, after first contact."""
+    data, whole = _aligned(data_dir, log)
+    t = data.t_s - data.t_s[0]
+    runs = {
+        "rls": {"method": "rls"},
+        "ekf": {"method": "ekf"},
+        "ekf walk 1e-3": {"method": "ekf", "surface_walk_m_per_sqrt_s": 1e-3},
+    }
+    cache, traces = {}, {}
+    for name, kwargs in runs.items():
+        trace = _replay(cache, data_dir, log, OnlineEstimatorParams(**kwargs)).trace
+        traces[name] = (trace, trace.t_s[np.flatnonzero(trace.in_contact)[0]])
+    print(f"{log}: ratios to the whole-log kappa {whole.kappa:.0f}")
+    print("  t after contact | trailing 2 s fit | " + " | ".join(runs))
+    t0 = traces["rls"][1] - data.t_s[0]
+    for after in (
+        0.5,
+        1.0,
+        1.5,
+        2.0,
+        2.5,
+        3.0,
+        3.5,
+        4.0,
+        6.0,
+        8.0,
+        10.0,
+        20.0,
+        40.0,
+        60.0,
+    ):
+        end = t0 + after
+        try:
+            window = (t >= end - 2.0) & (t < end)
+            fit = (
+                f"{fit_hunt_crossley(data, sample_mask=window).kappa / whole.kappa:.3f}"
+            )
+        except VicDrakeError:  # too few samples in contact
+            fit = "  -  "
+        cells = []
+        for trace, first in traces.values():
+            k = min(np.searchsorted(trace.t_s, first + after), trace.t_s.size - 1)
+            cells.append(f"{trace.kappa[k] / whole.kappa:.3f}")
+        print(f"  {after:5.1f} s | {fit} | " + " | ".join(cells))
+
+
 def creep_section(data_dir) -> None:
     for log, period in PALPATIONS.items():
         data = PalpationData.from_frame(read_bag(data_dir / log))
@@ -196,6 +245,7 @@ def scaled_section(data_dir) -> None:
 SECTIONS = {
     "settings": settings_section,
     "windows": windows_section,
+    "trajectory": trajectory_section,
     "creep": creep_section,
     "scaled": scaled_section,
 }
