@@ -328,6 +328,8 @@ def test_simulated_nominal_scan_has_no_significant_motion(simulated_scans):
     motion = est["phantom_lift_m"].to_numpy()[m]
     assert np.mean(np.abs(motion) <= est["phantom_lift_sigma_m"].to_numpy()[m]) > 0.95
     assert motion_significance(est) < SIGNIFICANT_FRACTION / 10
+    assert longest_excursion_s(est) == 0.0 and unexplained_loss_z(est) == 0.0
+    assert not motion_is_significant(est)
 
 
 @pytest.mark.realdata

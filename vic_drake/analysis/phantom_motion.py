@@ -49,7 +49,7 @@ SIGNIFICANT_FRACTION = 0.10
 #: The motion is also significant when one contiguous run of samples beyond
 #: SIGNIFICANCE_Z lasts at least this many averaging windows: one odd raw
 #: sample moves the averaged estimate over one window only, and a run of
-#: two independent windows beyond 3 sigma has odds of order 1e-5.
+#: two independent windows beyond 3 sigma has odds of about 7e-6.
 EXCURSION_WINDOWS = 2.0
 #: 1-sigma change of the surface estimate between two samples of a log where
 #: nothing moved, m, and its growth with their distance in x, m/m (nominal
@@ -145,8 +145,7 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
 
 
 def _sustained(t: np.ndarray, contact: np.ndarray) -> np.ndarray:
-    """``contact`` without its runs shorter than MIN_CONTACT_LOSS_S: force
-    noise over the threshold in the air lasts a sample or two."""
+    """``contact`` less its runs under MIN_CONTACT_LOSS_S (noise in the air)."""
     out = np.asarray(contact, bool).copy()
     dt = float(np.median(np.diff(t))) if len(t) > 1 else 0.0
     for a, b in _runs(out):
@@ -252,8 +251,9 @@ def estimate_phantom_motion(
         DataFrame with t_s, phantom_lift_m (the motion, m, > 0 up),
         phantom_lift_sigma_m (1-sigma), upper_bound_m (out of contact, the
         bound from the tip: the motion is at most this; NaN in contact) and
-        measured (bool: from contact);
-        ``attrs["reference"]`` is "nominal log" or "phantom map".
+        measured (bool: from contact), loss_descent_m / _sigma_m (see
+        :func:`_loss_descent`); ``attrs``: "reference" ("nominal log" or
+        "phantom map") and "smooth_s".
 
     Raises:
         VicDrakeError: missing columns, fewer than two contact samples,
