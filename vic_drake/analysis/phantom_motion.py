@@ -52,9 +52,9 @@ SIGNIFICANT_FRACTION = 0.10
 #: two independent windows beyond 3 sigma has odds of about 7e-6.
 EXCURSION_WINDOWS = 2.0
 #: 1-sigma change of the surface estimate between two samples of a log where
-#: nothing moved, m, and its growth with their distance in x, m/m (nominal
-#: logs: RMS 0.09-0.20 mm under 0.5 mm apart, 0.40-0.57 mm at 4-8 mm).
-LOCAL_SURFACE_SIGMA_M = 0.3e-3
+#: nothing moved, m, and its growth with their distance in x, m/m: above the
+#: nominal logs' RMS at every distance (0.09-0.38 mm under 2 mm apart).
+LOCAL_SURFACE_SIGMA_M = 0.4e-3
 MAP_SLOPE_SIGMA = 0.09
 #: Smallest kappa_eff / kappa the viscous inversion uses: below it (a fast
 #: release) the force says little about the penetration and the static
