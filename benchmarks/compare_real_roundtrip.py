@@ -4,7 +4,8 @@ Per seed, one :func:`vic_drake.experiments.hand_roundtrip.hand_moved_roundtrip`:
 a shared log's scenario with random hand motion (``--events`` lifts and fast
 drops below rest) is simulated, written as the rig's bag and fed to
 compare-real. Printed: the motion estimate against the truth (RMS in and out
-of contact, mm), the replayed motion against the truth, force RMSE, peaks,
+of contact, mm), the replayed motion against the truth, whether compare-real
+replayed it (and the fraction beyond 3 sigma), force RMSE, peaks,
 contact loss of the bag vs the replay and their overlap. Needs the data (the
 measured map).
 

@@ -9,14 +9,17 @@ import pytest
 from tests.analysis.scans import make_scan
 from vic_drake.analysis.contact import contact_loss_intervals
 from vic_drake.analysis.phantom_motion import (
+    SIGNIFICANCE_Z,
     SIGNIFICANT_FRACTION,
     estimate_phantom_motion,
     lift_table,
+    longest_excursion_s,
     map_surface_error_m,
     motion_is_significant,
     motion_significance,
     penetration_m,
     replay_table,
+    unexplained_loss_z,
 )
 from vic_drake.errors import VicDrakeError
 from vic_drake.tissue import hunt_crossley_force
@@ -98,6 +101,81 @@ def test_nominal_scan_has_no_motion_and_is_not_replayed():
     assert np.max(np.abs(motion)) < 2e-4
     assert motion_significance(est) == 0.0 and not motion_is_significant(est)
     assert replay_table(est) == []
+
+
+def _chase(t, drop_m, drop_s, t0=6.0, tip_rate=0.02):
+    """A drop of the surface faster than the tip that chases it at tip_rate."""
+    lift = -drop_m * _ramp(t, t0, t0 + drop_s)
+    z = 0.093 - drop_m * _ramp(t, t0, t0 + drop_m / tip_rate)
+    return lift, z
+
+
+def test_a_contact_loss_the_resting_phantom_cannot_explain_is_significant():
+    """A 15 mm drop in 0.1 s: the probe loses contact for 0.45 s (the viscous
+    term cuts the force at once) and sinks 9 mm meanwhile without touching. With a map error of 6 mm (3 sigma above
+    the drop) no sample leaves the band, so only the loss says the phantom
+    moved; the old rule (the fraction alone) did not replay it."""
+    t = np.arange(0.0, 10.0, 0.002)
+    lift, z = _chase(t, 0.015, 0.1)
+    df = _scan_over(lift, z, t, noise_N=0.045)
+    losses = contact_loss_intervals(df)
+    assert len(losses) == 1 and 0.4 < losses[0][1] - losses[0][0] < 0.5
+    est = estimate_phantom_motion(df, _flat_phantom(), map_surface_sigma_m=6e-3)
+    assert motion_significance(est) == 0.0 and longest_excursion_s(est) == 0.0
+    assert unexplained_loss_z(est) > 2 * SIGNIFICANCE_Z
+    assert motion_is_significant(est)
+    assert replay_table(est) == lift_table(est)
+
+
+def test_a_contact_loss_the_tip_makes_itself_is_not_evidence():
+    """The tip lifts off a resting phantom for 0.5 s mid-scan and comes back,
+    and bounces at the first touch: the losses need no motion."""
+    t = np.arange(0.0, 10.0, 0.002)
+    z = 0.093 + 0.012 * (_ramp(t, 5.0, 5.2) - _ramp(t, 5.7, 5.9))
+    z += 0.009 * (_ramp(t, 0.3, 0.32) - _ramp(t, 0.36, 0.4))
+    df = _scan_over(np.zeros_like(t), z, t, noise_N=0.045)
+    assert len(contact_loss_intervals(df)) == 2
+    est = estimate_phantom_motion(df, _flat_phantom())
+    assert unexplained_loss_z(est) < 1.0
+    assert not motion_is_significant(est)
+
+
+def test_a_short_scan_with_one_excursion_is_significant():
+    """A 9 mm lift held 0.6 s in a 20 s scan: 5 % of the samples lie beyond
+    3 sigma (under the old rule's 10 %), in one run of three averaging windows."""
+    t = np.arange(0.0, 20.0, 0.002)
+    lift = 0.009 * (_ramp(t, 8.0, 8.3) - _ramp(t, 9.0, 9.3))
+    z = 0.093 + 0.8 * lift
+    df = _scan_over(lift, z, t, noise_N=0.045)
+    est = estimate_phantom_motion(df, _flat_phantom(), map_surface_sigma_m=2e-3)
+    assert 0.02 < motion_significance(est) < SIGNIFICANT_FRACTION
+    assert longest_excursion_s(est) > 0.5
+    assert motion_is_significant(est)
+
+
+@pytest.mark.parametrize("fault", ["spike", "dropout", "noisy stretch", "z glitch"])
+def test_one_odd_sample_or_one_noisy_stretch_is_not_motion(fault):
+    """A resting phantom whose log has one force spike of 25 N, one sample of
+    no force, 0.3 s of 3 N noise or one tip sample 20 mm off: nothing is replayed."""
+    t = np.arange(0.0, 12.0, 0.002)
+    df = _scan_over(np.zeros_like(t), np.full_like(t, 0.093), t, noise_N=0.045)
+    f = -df["force_sensor_z_N"].to_numpy().copy()
+    i = 3000
+    if fault == "spike":
+        f[i] += 25.0
+    elif fault == "dropout":
+        f[i] = 0.0
+    elif fault == "noisy stretch":
+        f[i : i + 150] += np.random.default_rng(1).normal(0.0, 3.0, 150)
+    else:
+        z = df["z_m"].to_numpy().copy()
+        z[i] -= 0.02
+        df["z_m"] = z
+    df["force_sensor_z_N"] = -f
+    est = estimate_phantom_motion(df, _flat_phantom(), map_surface_sigma_m=1e-3)
+    assert longest_excursion_s(est) < 0.4
+    assert unexplained_loss_z(est) < SIGNIFICANCE_Z
+    assert not motion_is_significant(est)
 
 
 def test_viscous_inversion_beats_the_static_law_on_a_fast_indentation():
@@ -250,6 +328,8 @@ def test_simulated_nominal_scan_has_no_significant_motion(simulated_scans):
     motion = est["phantom_lift_m"].to_numpy()[m]
     assert np.mean(np.abs(motion) <= est["phantom_lift_sigma_m"].to_numpy()[m]) > 0.95
     assert motion_significance(est) < SIGNIFICANT_FRACTION / 10
+    assert longest_excursion_s(est) == 0.0 and unexplained_loss_z(est) == 0.0
+    assert not motion_is_significant(est)
 
 
 @pytest.mark.realdata
@@ -282,3 +362,28 @@ def test_real_contact_losses_lie_where_the_surface_is_below_the_tip(data_dir, lo
         assert np.mean(upper[inside] - motion[inside]) > 1e-4
     quiet = estimate_phantom_motion(nominal, phantom)
     assert not motion_is_significant(quiet)
+
+
+@pytest.mark.realdata
+@pytest.mark.parametrize(
+    "log",
+    [
+        "test_compliance_control400",
+        "test_force_control",
+        "test_tracking5",
+        "test_nardi_matForce_lowR",
+    ],
+)
+def test_the_nominal_logs_show_no_motion_by_any_test(data_dir, log):
+    """No sample beyond 3 sigma, and the few dips under the contact threshold
+    at the first touch (at most 12 ms) are no losses."""
+    from vic_drake.analysis.columns import real_to_canonical
+    from vic_drake.realdata import read_bag
+    from vic_drake.tissue.phantom import load_phantom
+
+    real = real_to_canonical(read_bag(data_dir / "experiments" / log))
+    est = estimate_phantom_motion(real, load_phantom("measured", data_dir=data_dir))
+    assert motion_significance(est) == 0.0
+    assert longest_excursion_s(est) == 0.0
+    assert unexplained_loss_z(est) == 0.0
+    assert not motion_is_significant(est)

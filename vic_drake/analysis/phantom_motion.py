@@ -8,9 +8,11 @@ the tip is the tip height plus that penetration; its difference from the
 undisturbed surface (a nominal log of the same scan when there is one,
 else the map) is the motion. Out of contact the surface lies below the tip:
 the motion is bounded above by the tip height minus the undisturbed
-surface. :func:`motion_is_significant` decides, from the whole record,
-whether the motion stands out of its uncertainty (compare-real replays it
-only then); :func:`lift_table` turns it into a scenario table.
+surface. :func:`motion_is_significant` decides whether the motion stands
+out of its uncertainty (compare-real replays it only then): enough of the
+record beyond the band, one excursion beyond it longer than the averaging
+can make of one odd sample, or a contact loss the resting phantom cannot
+explain; :func:`lift_table` turns it into a scenario table.
 
 Why each constant is what it is: docs/decisions.md, "Phantom motion from a
 scan log".
@@ -21,7 +23,7 @@ import pandas as pd
 from scipy.signal import savgol_filter
 
 from vic_drake.analysis.columns import require_columns
-from vic_drake.analysis.contact import pressing_force_N
+from vic_drake.analysis.contact import MIN_CONTACT_LOSS_S, pressing_force_N
 from vic_drake.errors import VicDrakeError
 from vic_drake.paper import CONTACT_THRESHOLD_N
 
@@ -44,6 +46,16 @@ SIGNIFICANCE_Z = 3.0
 #: error leaves 0.3 % beyond 3 sigma, and no single sample can flip it
 #: (10 % is 2 s of a 20 s scan).
 SIGNIFICANT_FRACTION = 0.10
+#: The motion is also significant when one contiguous run of samples beyond
+#: SIGNIFICANCE_Z lasts at least this many averaging windows: one odd raw
+#: sample moves the averaged estimate over one window only, and a run of
+#: two independent windows beyond 3 sigma has odds of about 7e-6.
+EXCURSION_WINDOWS = 2.0
+#: 1-sigma change of the surface estimate between two samples of a log where
+#: nothing moved, m, and its growth with their distance in x, m/m: above the
+#: nominal logs' RMS at every distance (0.09-0.38 mm under 2 mm apart).
+LOCAL_SURFACE_SIGMA_M = 0.4e-3
+MAP_SLOPE_SIGMA = 0.09
 #: Smallest kappa_eff / kappa the viscous inversion uses: below it (a fast
 #: release) the force says little about the penetration and the static
 #: law's answer is kept within a factor 2 in stiffness.
@@ -122,6 +134,26 @@ def penetration_m(
     return eps
 
 
+def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
+    """(first, last) index of each run of True."""
+    idx = np.flatnonzero(mask)
+    if idx.size == 0:
+        return []
+    starts = idx[np.r_[True, np.diff(idx) > 1]]
+    ends = idx[np.r_[np.diff(idx) > 1, True]]
+    return list(zip(starts.tolist(), ends.tolist()))
+
+
+def _sustained(t: np.ndarray, contact: np.ndarray) -> np.ndarray:
+    """``contact`` less its runs under MIN_CONTACT_LOSS_S (noise in the air)."""
+    out = np.asarray(contact, bool).copy()
+    dt = float(np.median(np.diff(t))) if len(t) > 1 else 0.0
+    for a, b in _runs(out):
+        if t[b] - t[a] + dt < MIN_CONTACT_LOSS_S:
+            out[a : b + 1] = False
+    return out
+
+
 def _gap_depth(t, keep, eps, smooth_s) -> np.ndarray:
     """How far under the tip the surface may lie in each gap without contact, m.
 
@@ -132,12 +164,7 @@ def _gap_depth(t, keep, eps, smooth_s) -> np.ndarray:
     (0 in contact and at the record's ends, where one side is missing).
     """
     depth = np.zeros(len(t))
-    idx = np.flatnonzero(~keep)
-    if idx.size == 0:
-        return depth
-    starts = idx[np.r_[True, np.diff(idx) > 1]]
-    ends = idx[np.r_[np.diff(idx) > 1, True]]
-    for i0, i1 in zip(starts, ends):
+    for i0, i1 in _runs(~keep):
         if i0 == 0 or i1 == len(t) - 1:
             continue
         before = keep & (t >= t[i0] - smooth_s) & (t < t[i0])
@@ -224,8 +251,9 @@ def estimate_phantom_motion(
         DataFrame with t_s, phantom_lift_m (the motion, m, > 0 up),
         phantom_lift_sigma_m (1-sigma), upper_bound_m (out of contact, the
         bound from the tip: the motion is at most this; NaN in contact) and
-        measured (bool: from contact);
-        ``attrs["reference"]`` is "nominal log" or "phantom map".
+        measured (bool: from contact), loss_descent_m / _sigma_m (see
+        :func:`_loss_descent`); ``attrs``: "reference" ("nominal log" or
+        "phantom map") and "smooth_s".
 
     Raises:
         VicDrakeError: missing columns, fewer than two contact samples,
@@ -297,6 +325,7 @@ def estimate_phantom_motion(
     eps_thr = (CONTACT_THRESHOLD_N / kappa) ** (1.0 / beta)
     sigma_gap = np.sqrt(sigma_bridge**2 + eps_thr**2 + (depth / 2) ** 2)
     sigma = np.where(keep, sigma_c, sigma_gap)
+    descent, descent_sigma = _loss_descent(t, x, keep, tip_level, upper)
     out = pd.DataFrame(
         {
             "t_s": t,
@@ -304,10 +333,37 @@ def estimate_phantom_motion(
             "phantom_lift_sigma_m": sigma,
             "upper_bound_m": np.where(keep, np.nan, upper),
             "measured": keep,
+            "loss_descent_m": descent,
+            "loss_descent_sigma_m": descent_sigma,
         }
     )
     out.attrs["reference"] = "phantom map" if nominal is None else "nominal log"
+    out.attrs["smooth_s"] = smooth_s
     return out
+
+
+def _loss_descent(t, x, keep, tip_level, upper):
+    """How far, in each gap between two contacts of at least
+    MIN_CONTACT_LOSS_S, the surface must have fallen since the gap's last
+    contact sample, m, and its 1-sigma (NaN elsewhere).
+
+    When contact is lost the surface touches the tip (``tip_level``, its
+    height above the reference); a resting surface stays there or, relaxing,
+    rises, and the tip must stay above it less the penetration an under-
+    threshold force allows (``upper``, that bound on the motion). Descent:
+    the tip's level at the last contact minus the bound; 1-sigma: the
+    estimate's change between two samples of a resting log that far apart.
+    """
+    descent = np.full(len(t), np.nan)
+    sig = np.full(len(t), np.nan)
+    for i0, i1 in _runs(~_sustained(t, keep)):
+        if i0 == 0 or i1 == len(t) - 1:
+            continue
+        span = slice(i0, i1 + 1)
+        descent[span] = tip_level[i0 - 1] - upper[span]
+        dx = np.abs(x[span] - x[i0 - 1])
+        sig[span] = np.hypot(LOCAL_SURFACE_SIGMA_M, MAP_SLOPE_SIGMA * dx)
+    return descent, sig
 
 
 def motion_significance(motion: pd.DataFrame) -> float:
@@ -323,9 +379,56 @@ def motion_significance(motion: pd.DataFrame) -> float:
     return float(np.mean(np.abs(v) > SIGNIFICANCE_Z * s))
 
 
+def longest_excursion_s(motion: pd.DataFrame) -> float:
+    """Longest contiguous run, from the first to the last contact (runs of
+    contact of at least MIN_CONTACT_LOSS_S), of samples whose motion exceeds
+    :data:`SIGNIFICANCE_Z` of its band, s."""
+    require_columns(motion, "t_s", "phantom_lift_m", "phantom_lift_sigma_m", "measured")
+    t = motion["t_s"].to_numpy(float)
+    m = _sustained(t, motion["measured"].to_numpy(bool))
+    if not m.any():
+        return 0.0
+    i0, i1 = int(np.argmax(m)), len(m) - 1 - int(np.argmax(m[::-1]))
+    v = motion["phantom_lift_m"].to_numpy(float)
+    s = motion["phantom_lift_sigma_m"].to_numpy(float)
+    beyond = np.zeros(len(m), bool)
+    beyond[i0 : i1 + 1] = np.abs(v[i0 : i1 + 1]) > SIGNIFICANCE_Z * s[i0 : i1 + 1]
+    dt = float(np.median(np.diff(t))) if len(t) > 1 else 0.0
+    return float(max((t[b] - t[a] + dt for a, b in _runs(beyond)), default=0.0))
+
+
+def unexplained_loss_z(motion: pd.DataFrame) -> float:
+    """Largest descent, in sigmas, that a contact loss of at least
+    :data:`~vic_drake.analysis.contact.MIN_CONTACT_LOSS_S` demands of the
+    surface (``loss_descent_m`` / ``loss_descent_sigma_m``), 0.0 without such
+    a loss or those columns. Beyond :data:`SIGNIFICANCE_Z` the resting
+    phantom cannot explain the loss: the tip went that far below its height
+    when contact was lost (less the penetration the force allows), and the
+    force stayed under the contact threshold."""
+    cols = ("t_s", "loss_descent_m", "loss_descent_sigma_m")
+    if not all(c in motion.columns for c in cols):
+        return 0.0
+    t = motion["t_s"].to_numpy(float)
+    d = motion["loss_descent_m"].to_numpy(float)
+    s = motion["loss_descent_sigma_m"].to_numpy(float)
+    best = 0.0
+    for a, b in _runs(np.isfinite(d)):
+        if b + 1 < len(t) and t[b + 1] - t[a] >= MIN_CONTACT_LOSS_S:
+            best = max(best, float(np.max(d[a : b + 1] / s[a : b + 1])))
+    return best
+
+
 def motion_is_significant(motion: pd.DataFrame) -> bool:
-    """True when :func:`motion_significance` reaches :data:`SIGNIFICANT_FRACTION`."""
-    return motion_significance(motion) >= SIGNIFICANT_FRACTION
+    """True when the motion stands out of its band: :func:`motion_significance`
+    reaches :data:`SIGNIFICANT_FRACTION`, or :func:`longest_excursion_s` lasts
+    :data:`EXCURSION_WINDOWS` averaging windows (``attrs["smooth_s"]``, else
+    0.2 s), or :func:`unexplained_loss_z` reaches :data:`SIGNIFICANCE_Z`."""
+    smooth_s = float(motion.attrs.get("smooth_s", 0.2))
+    return bool(
+        motion_significance(motion) >= SIGNIFICANT_FRACTION
+        or longest_excursion_s(motion) >= EXCURSION_WINDOWS * smooth_s
+        or unexplained_loss_z(motion) >= SIGNIFICANCE_Z
+    )
 
 
 def map_surface_error_m(df: pd.DataFrame, phantom, nominal: pd.DataFrame) -> np.ndarray:
@@ -375,7 +478,10 @@ def lift_table(lift: pd.DataFrame, *, dt_s: float = 0.05) -> list[list[float]]:
 
 
 __all__ = [
+    "EXCURSION_WINDOWS",
+    "LOCAL_SURFACE_SIGMA_M",
     "MAP_KAPPA_REL_SIGMA",
+    "MAP_SLOPE_SIGMA",
     "MAP_SURFACE_SIGMA_M",
     "SIGNIFICANCE_Z",
     "SIBLING_SIGMA_M",
@@ -383,9 +489,11 @@ __all__ = [
     "estimate_phantom_motion",
     "force_noise_N",
     "lift_table",
+    "longest_excursion_s",
     "map_surface_error_m",
     "motion_is_significant",
     "motion_significance",
     "penetration_m",
     "replay_table",
+    "unexplained_loss_z",
 ]

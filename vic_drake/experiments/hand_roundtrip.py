@@ -85,7 +85,8 @@ def hand_moved_roundtrip(
     Returns:
         dict: seed, first_event_s, controller; the motion estimate against
         the truth, mm (true_motion_max_mm, est_rms_contact_mm,
-        est_rms_gap_mm, replay_rms_mm); compare-real's force_rmse_N,
+        est_rms_gap_mm, replay_rms_mm); compare-real's motion_significance
+        and motion_replayed (``phantom_motion_*``), force_rmse_N,
         peak_sim_N / peak_real_N ("real" is the bag), loss_sim_s /
         loss_real_s / loss_overlap_s, surface_offset_mm against
         truth_offset_mm.
@@ -150,6 +151,8 @@ def hand_moved_roundtrip(
         "est_rms_contact_mm": rms(err[after & measured]),
         "est_rms_gap_mm": rms(err[gap]),
         "replay_rms_mm": rms((replayed - lift)[live]),
+        "motion_significance": out["phantom_motion_significance"],
+        "motion_replayed": out["phantom_motion_replayed"],
         "force_rmse_N": out["force_rmse_N"],
         "peak_sim_N": out["force_peak_sim_N"],
         "peak_real_N": out["force_peak_real_N"],
