@@ -20,6 +20,7 @@ from vic_drake.control.tank import tank_step
 from vic_drake.errors import VicDrakeError
 from vic_drake.systems.controller import MakeVariableImpedanceController
 from vic_drake.systems.references import ForceReferenceSystem
+from vic_drake.systems.signals import REF_PROBE_POSITION, REF_PROBE_VELOCITY
 from vic_drake.systems.stiffness_qp import StiffnessQpSystem
 from vic_drake.systems.tank import EnergyTankSystem
 from vic_drake.tissue.phantom import GridPhantom
@@ -233,6 +234,23 @@ def test_qp_reads_the_tanks_energy(phantom):
             qp.GetInputPort("tank_energy").Eval(qp.GetMyContextFromRoot(context)),
             tank.get_energy_output_port().Eval(tank.GetMyContextFromRoot(context)),
         )
+
+
+def test_qp_reads_the_probe_state_the_references_used(phantom):
+    """The QP's p, v are the head of the reference tick's record: the Diagram's
+    probe inputs, also after they change."""
+    _, diagram, context = make(phantom, "vs-vf")
+    qp = diagram.GetSubsystemByName("stiffness_qp")
+    p2, v2 = P_WP + [0.001, -0.002, 0.0005], V_WP + [0.003, 0.0, -0.001]
+    for p, v in ((P_WP, V_WP), (p2, v2)):
+        diagram.GetInputPort("probe.position").FixValue(context, p)
+        diagram.GetInputPort("probe.velocity").FixValue(context, v)
+        head = qp.GetInputPort("reference_tick").Eval(qp.GetMyContextFromRoot(context))
+        np.testing.assert_array_equal(head[REF_PROBE_POSITION], p)
+        np.testing.assert_array_equal(head[REF_PROBE_VELOCITY], v)
+        tick(diagram, context)
+        record = out(diagram, context, "tick_record")
+        np.testing.assert_array_equal(record[:6], [*p, *v])
 
 
 def test_osqp_system_matches_exact_system(phantom):

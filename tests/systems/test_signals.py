@@ -34,8 +34,11 @@ from vic_drake.systems.signals import (
     REF_FORCE_REFERENCE,
     REF_IN_CONTACT,
     REF_PENETRATION,
+    REF_PROBE_POSITION,
+    REF_PROBE_VELOCITY,
     REF_SURFACE_VELOCITY,
     REF_TARGET_FORCE,
+    REFERENCE_TICK_SIZE,
     REFERENCES_SIZE,
     STATUS_FIELDS,
     TANK_FIELDS,
@@ -90,6 +93,14 @@ def test_layouts_cover_their_vectors_once():
                  QP_TICK_DAMPING_USED, QP_TICK_ACTIVE):  # fmt: skip
         covered[part] += 1
     assert np.all(covered == 1)
+    # The QP's reference_tick: the references, then the tick record's p, v.
+    record = REFERENCE_TICK_SIZE - REFERENCES_SIZE
+    assert TICK_RECORD_FIELDS[:record] == ("x_m", "y_m", "z_m", "vx_m_per_s",
+                                           "vy_m_per_s", "vz_m_per_s")  # fmt: skip
+    assert (REF_PROBE_POSITION.start, REF_PROBE_VELOCITY.stop) == (
+        REFERENCES_SIZE,
+        REFERENCE_TICK_SIZE,
+    )
 
 
 def test_reference_system_ports_and_layout(phantom):
@@ -123,6 +134,9 @@ def test_reference_system_ports_and_layout(phantom):
         whole[REFERENCES_SIZE : REFERENCES_SIZE + len(TICK_RECORD_FIELDS)],
         [*P_WP, *V_WP, *F_W, KAPPA, LAM],
     )
+    # Its head is the QP's reference_tick: the measurement the references used.
+    np.testing.assert_array_equal(whole[REF_PROBE_POSITION], P_WP)
+    np.testing.assert_array_equal(whole[REF_PROBE_VELOCITY], V_WP)
     expected = force_references(contact=True, kappa=KAPPA, lam=LAM, eps_dot=-V_WP[2],
                                 beta=BETA, ref=p.reference, qp=p.qp)  # fmt: skip
     np.testing.assert_allclose(
@@ -163,9 +177,11 @@ def test_reference_system_fault_layout(phantom):
 
 
 def _qp_context(system, refs, energy=0.5):
+    """The QP reads the references with the probe p, v they used (its
+    "reference_tick", the head of the reference system's "tick")."""
     context = system.CreateDefaultContext()
-    for name, value in (("probe.position", P_WP), ("probe.velocity", V_WP),
-                        ("target_position", X_D), ("references", refs),
+    reference_tick = np.concatenate([refs, P_WP, V_WP])
+    for name, value in (("target_position", X_D), ("reference_tick", reference_tick),
                         ("tank_energy", [energy])):  # fmt: skip
         system.GetInputPort(name).FixValue(context, value)
     return context
@@ -184,10 +200,8 @@ def test_qp_system_publishes_what_its_tick_used():
     p = params("vs-vf")
     system = StiffnessQpSystem(p)
     assert ports(system, "input") == {
-        "probe.position": 3,
-        "probe.velocity": 3,
         "target_position": 3,
-        "references": REFERENCES_SIZE,
+        "reference_tick": REFERENCE_TICK_SIZE,
         "tank_energy": 1,
     }
     assert ports(system, "output") == {

@@ -10,9 +10,10 @@ named "variable_impedance_controller" composing
 - "energy_tank" (:class:`EnergyTankSystem`): T, power, sigma, enabled,
 
 all at ``params.period_s`` (500 Hz by default). The QP reads its references
-(the head of "force_reference"'s "tick" vector) and T (an element of the
-tank's "tank" record) through two C++ Demultiplexers, "reference_fields"
-and "tank_fields", so that neither read calls Python. All four controllers (CS,
+and the probe position and velocity they were computed from (the head of
+"force_reference"'s "tick" vector) and T (an element of the tank's "tank"
+record) through two C++ Demultiplexers, "reference_fields" and
+"tank_fields", so that neither read calls Python. All four controllers (CS,
 CF, VS-CF, VS-VF) expose the same ports; see
 :class:`vic_drake.control.params.ReferenceParams` for how each maps to
 (stiffness, target_force) of the compliance (FDCC) stage.
@@ -29,7 +30,7 @@ from vic_drake.estimation.online import OnlineEstimatorParams
 from vic_drake.systems.online_estimator import OnlineEstimatorSystem
 from vic_drake.systems.references import ForceReferenceSystem
 from vic_drake.systems.signals import (
-    REFERENCES_SIZE,
+    REFERENCE_TICK_SIZE,
     STATUS_FIELDS,
     TANK_ENERGY,
     TANK_FIELDS,
@@ -135,7 +136,6 @@ def MakeVariableImpedanceController(
 
     for name in ("probe.position", "probe.velocity"):
         index = builder.ExportInput(ref.GetInputPort(name), name)
-        builder.ConnectInput(index, qp.GetInputPort(name))
         if online:
             builder.ConnectInput(index, est.GetInputPort(name))
     builder.ExportInput(qp.GetInputPort("target_position"), "target_position")
@@ -145,16 +145,21 @@ def MakeVariableImpedanceController(
     if online:
         builder.ConnectInput(index, est.GetInputPort("ft_sensor.force_W"))
 
-    # The QP reads the references from the reference system's "tick" vector
-    # through a C++ Demultiplexer: no Python output callback per tick.
+    # The QP reads the references, and the probe's position and velocity they
+    # were computed from, from the head of the reference system's "tick"
+    # vector through a C++ Demultiplexer: no Python output callback per tick
+    # and no Eval of the probe ports of its own.
     ref_fields = builder.AddNamedSystem(
         "reference_fields",
         Demultiplexer(
-            [REFERENCES_SIZE, ref.get_tick_output_port().size() - REFERENCES_SIZE]
+            [
+                REFERENCE_TICK_SIZE,
+                ref.get_tick_output_port().size() - REFERENCE_TICK_SIZE,
+            ]
         ),
     )
     builder.Connect(ref.get_tick_output_port(), ref_fields.get_input_port())
-    builder.Connect(ref_fields.get_output_port(0), qp.GetInputPort("references"))
+    builder.Connect(ref_fields.get_output_port(0), qp.GetInputPort("reference_tick"))
     # The QP reads T from the "tank" record through a C++ Demultiplexer: the
     # number of the tank's own "tank_energy" port, with no Python call per tick.
     tank_fields = builder.AddNamedSystem(

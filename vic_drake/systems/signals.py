@@ -4,11 +4,11 @@ Most controller signals are ports of their own. A few vectors stay packed
 (see docs/decisions.md, "Controller signals") and are described here, the
 one place both their writer and their readers take the layout from:
 
-- ``references`` (ForceReferenceSystem -> StiffnessQpSystem): the tick's
-  references, computed with direct feedthrough from the current measurement
-  in one cache entry. One port keeps the QP's update at one evaluation of a
-  Python output per tick (a port per signal would add one Python callback
-  each).
+- ``references`` (ForceReferenceSystem): the tick's references, computed
+  with direct feedthrough from the current measurement; with the probe
+  position and velocity the tick read, the head of its "tick" vector, they
+  are StiffnessQpSystem's ``reference_tick`` input (one port evaluation,
+  through a C++ Demultiplexer in the controller Diagram).
 - ``contact`` (ForceReferenceSystem, state of the last tick): the contact
   part of ``references``.
 - ``qp_tick`` (StiffnessQpSystem -> EnergyTankSystem): what the QP's last
@@ -58,6 +58,15 @@ REF_IN_CONTACT = 9 + CONTACT_FIELDS.index("in_contact")
 REF_PENETRATION = 9 + CONTACT_FIELDS.index("penetration_m")
 REF_FAULT = 9 + CONTACT_FIELDS.index("fault")
 REF_SURFACE_VELOCITY = 9 + CONTACT_FIELDS.index("surface_velocity_m_per_s")
+
+#: StiffnessQpSystem's "reference_tick" input: the head of
+#: ForceReferenceSystem's "tick" output, i.e. the "references" then the
+#: probe position p_WP (3, m) and velocity v_WP (3, m/s) the tick read (the
+#: first six :data:`TICK_RECORD_FIELDS`): the QP uses the measurement its
+#: references were computed from.
+REFERENCE_TICK_SIZE = REFERENCES_SIZE + 6
+REF_PROBE_POSITION = slice(REFERENCES_SIZE, REFERENCES_SIZE + 3)
+REF_PROBE_VELOCITY = slice(REFERENCES_SIZE + 3, REFERENCE_TICK_SIZE)
 
 #: The "qp_tick" port: the QP's last tick as the tank integrates it.
 #: e = x_d - x (3, m), e_dot = -x_dot (3, m/s), K (3, N/m), the damping D

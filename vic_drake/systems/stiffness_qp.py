@@ -33,6 +33,9 @@ from vic_drake.systems.signals import (
     REF_FORCE_REFERENCE,
     REF_IN_CONTACT,
     REF_PENETRATION,
+    REF_PROBE_POSITION,
+    REF_PROBE_VELOCITY,
+    REFERENCE_TICK_SIZE,
     REFERENCES_SIZE,
     STATUS_FALLBACK_COUNT,
     STATUS_FIELDS,
@@ -51,11 +54,12 @@ class StiffnessQpSystem(LeafSystem):
     """Diagonal stiffness from the QP of eq. 8 (or CS/CF's constant one).
 
     Input ports:
-        probe.position (3): p_WP, m.
-        probe.velocity (3): v_WP, m/s.
         target_position (3): x_d, m.
-        references (13): ForceReferenceSystem's "references" (F_ref, F_min,
-            target force, contact; layout in :mod:`vic_drake.systems.signals`).
+        reference_tick (19): the head of ForceReferenceSystem's "tick"
+            output: its "references" (F_ref, F_min, target force, contact),
+            then the probe position p_WP (m) and velocity v_WP (m/s) that
+            tick read (layout: ``REFERENCE_TICK_SIZE`` and the ``REF_*``
+            slices of :mod:`vic_drake.systems.signals`).
         tank_energy (1): T before this tick, J (EnergyTankSystem's
             "tank_energy"; in MakeVariableImpedanceController the same
             number, element TANK_ENERGY of its "tank" record, through a
@@ -101,20 +105,12 @@ class StiffnessQpSystem(LeafSystem):
         )
         ports = {}
         for name, size in (
-            ("probe.position", 3),
-            ("probe.velocity", 3),
             ("target_position", 3),
-            ("references", REFERENCES_SIZE),
+            ("reference_tick", REFERENCE_TICK_SIZE),
             ("tank_energy", 1),
         ):
             ports[name] = self.DeclareVectorInputPort(name, size)
-        (
-            self._in_position,
-            self._in_velocity,
-            self._in_target,
-            self._in_references,
-            self._in_energy,
-        ) = ports.values()
+        self._in_target, self._in_references, self._in_energy = ports.values()
         k0 = self._constant if self._constant is not None else self._k_min
         d0 = [2.0 * self._zeta * math.sqrt(k) for k in k0]
         status0 = np.zeros(len(STATUS_FIELDS))
@@ -152,10 +148,9 @@ class StiffnessQpSystem(LeafSystem):
         # On entry discrete_state holds the current state (a LeafSystem copies
         # it in before calling an update handler): K and the fallback count
         # are read there.
-        p_WP = self._in_position.Eval(context).tolist()
-        v_WP = self._in_velocity.Eval(context).tolist()
         x_d = self._in_target.Eval(context).tolist()
         refs = self._in_references.Eval(context).tolist()
+        p_WP, v_WP = refs[REF_PROBE_POSITION], refs[REF_PROBE_VELOCITY]
         energy = self._in_energy.Eval(context).tolist()[0]
         i_k, _, _, i_status = self._state_groups
         k_prev = discrete_state.value(i_k).tolist()
@@ -166,7 +161,7 @@ class StiffnessQpSystem(LeafSystem):
             zeta2 * math.sqrt(max(k_prev[2], 0.0)),
         )
         # A sum of floats is finite iff every term is (inf - inf = nan).
-        total = sum(p_WP) + sum(v_WP) + sum(x_d) + sum(refs) + energy
+        total = sum(p_WP) + sum(v_WP) + sum(x_d) + sum(refs[:REFERENCES_SIZE]) + energy
         fault = not math.isfinite(total) or refs[REF_FAULT] > 0.5
         e = e_dot = (0.0, 0.0, 0.0)
         ok, solve_time = True, 0.0
