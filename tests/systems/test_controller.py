@@ -218,9 +218,9 @@ def test_target_force_is_cf_only_and_zero_on_a_fault(phantom):
             for i in range(system.num_input_ports())
         )
         context = system.CreateDefaultContext()
-        system.get_probe_position_input_port().FixValue(context, P_WP)
-        system.get_probe_velocity_input_port().FixValue(context, V_WP)
-        system.get_measured_force_input_port().FixValue(context, F_W)
+        system.get_measurement_input_port().FixValue(
+            context, np.concatenate([P_WP, V_WP, F_W])
+        )
         np.testing.assert_array_equal(port.Eval(context), [0.0] * 3)
 
 

@@ -22,6 +22,10 @@ from vic_drake.control.tank import TankStep, tank_step
 from vic_drake.systems.references import ForceReferenceSystem
 from vic_drake.systems.signals import (
     CONTACT_FIELDS,
+    MEASURED_FORCE,
+    MEASURED_POSITION,
+    MEASURED_VELOCITY,
+    MEASUREMENT_SIZE,
     QP_TICK_ACTIVE,
     QP_TICK_DAMPING_USED,
     QP_TICK_POSITION_ERROR,
@@ -93,6 +97,14 @@ def test_layouts_cover_their_vectors_once():
                  QP_TICK_DAMPING_USED, QP_TICK_ACTIVE):  # fmt: skip
         covered[part] += 1
     assert np.all(covered == 1)
+    # The reference system's measurement: the tick record's p, v, f.
+    parts = (MEASURED_POSITION, MEASURED_VELOCITY, MEASURED_FORCE)
+    assert [(part.start, part.stop) for part in parts] == [(0, 3), (3, 6), (6, 9)]
+    assert MEASUREMENT_SIZE == 9 and TICK_RECORD_FIELDS[6:9] == (
+        "force_x_N",
+        "force_y_N",
+        "force_z_N",
+    )
     # The QP's reference_tick: the references, then the tick record's p, v.
     record = REFERENCE_TICK_SIZE - REFERENCES_SIZE
     assert TICK_RECORD_FIELDS[:record] == ("x_m", "y_m", "z_m", "vx_m_per_s",
@@ -106,11 +118,7 @@ def test_layouts_cover_their_vectors_once():
 def test_reference_system_ports_and_layout(phantom):
     p = params("vs-cf")
     system = ForceReferenceSystem(p, phantom=phantom)
-    assert ports(system, "input") == {
-        "probe.position": 3,
-        "probe.velocity": 3,
-        "ft_sensor.force_W": 3,
-    }
+    assert ports(system, "input") == {"measurement": MEASUREMENT_SIZE}
     assert ports(system, "output") == {
         "target_force": 3,
         "references": REFERENCES_SIZE,
@@ -122,9 +130,9 @@ def test_reference_system_ports_and_layout(phantom):
         "tick": REFERENCES_SIZE + len(TICK_RECORD_FIELDS) + 13,
     }
     context = system.CreateDefaultContext()
-    system.get_probe_position_input_port().FixValue(context, P_WP)
-    system.get_probe_velocity_input_port().FixValue(context, V_WP)
-    system.get_measured_force_input_port().FixValue(context, F_W)
+    system.get_measurement_input_port().FixValue(
+        context, np.concatenate([P_WP, V_WP, F_W])
+    )
     refs = system.get_references_output_port().Eval(context)
     # The "tick" vector (what the controller Diagram hands the QP through a
     # Demultiplexer) starts with the references, then the record.
@@ -167,9 +175,9 @@ def test_reference_system_fault_layout(phantom):
     p = params("vs-vf")
     system = ForceReferenceSystem(p, phantom=phantom)
     context = system.CreateDefaultContext()
-    system.get_probe_position_input_port().FixValue(context, [0.0, math.nan, 0.1])
-    system.get_probe_velocity_input_port().FixValue(context, V_WP)
-    system.get_measured_force_input_port().FixValue(context, F_W)
+    system.get_measurement_input_port().FixValue(
+        context, np.concatenate([[0.0, math.nan, 0.1], V_WP, F_W])
+    )
     refs = system.get_references_output_port().Eval(context)
     assert refs[REF_FAULT] == 1.0 and refs[REF_IN_CONTACT] == 0.0
     np.testing.assert_array_equal(refs[REF_FORCE_REFERENCE], [0.0, 0.0, 0.0])

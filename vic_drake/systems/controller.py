@@ -13,7 +13,9 @@ all at ``params.period_s`` (500 Hz by default). The QP reads its references
 and the probe position and velocity they were computed from (the head of
 "force_reference"'s "tick" vector) and T (an element of the tank's "tank"
 record) through two C++ Demultiplexers, "reference_fields" and
-"tank_fields", so that neither read calls Python. All four controllers (CS,
+"tank_fields", so that neither read calls Python; the reference system reads
+the three measured inputs as one vector built by a C++ Multiplexer,
+"measurement". All four controllers (CS,
 CF, VS-CF, VS-VF) expose the same ports; see
 :class:`vic_drake.control.params.ReferenceParams` for how each maps to
 (stiffness, target_force) of the compliance (FDCC) stage.
@@ -22,7 +24,7 @@ CF, VS-CF, VS-VF) expose the same ports; see
 from __future__ import annotations
 
 from pydrake.systems.framework import Diagram, DiagramBuilder
-from pydrake.systems.primitives import Demultiplexer
+from pydrake.systems.primitives import Demultiplexer, Multiplexer
 
 from vic_drake.control.params import ControllerParams
 from vic_drake.errors import VicDrakeError
@@ -30,6 +32,9 @@ from vic_drake.estimation.online import OnlineEstimatorParams
 from vic_drake.systems.online_estimator import OnlineEstimatorSystem
 from vic_drake.systems.references import ForceReferenceSystem
 from vic_drake.systems.signals import (
+    MEASURED_FORCE,
+    MEASURED_POSITION,
+    MEASURED_VELOCITY,
     REFERENCE_TICK_SIZE,
     STATUS_FIELDS,
     TANK_ENERGY,
@@ -134,16 +139,22 @@ def MakeVariableImpedanceController(
     qp = builder.AddNamedSystem("stiffness_qp", StiffnessQpSystem(params))
     tank = builder.AddNamedSystem("energy_tank", EnergyTankSystem(params))
 
-    for name in ("probe.position", "probe.velocity"):
-        index = builder.ExportInput(ref.GetInputPort(name), name)
+    # The reference system reads the three measured vectors as one, built by
+    # a C++ Multiplexer: one port evaluation per tick instead of three.
+    parts = {
+        "probe.position": MEASURED_POSITION,
+        "probe.velocity": MEASURED_VELOCITY,
+        "ft_sensor.force_W": MEASURED_FORCE,
+    }
+    measurement = builder.AddNamedSystem(
+        "measurement", Multiplexer([part.stop - part.start for part in parts.values()])
+    )
+    builder.Connect(measurement.get_output_port(0), ref.get_measurement_input_port())
+    for i, name in enumerate(parts):
+        index = builder.ExportInput(measurement.get_input_port(i), name)
         if online:
             builder.ConnectInput(index, est.GetInputPort(name))
     builder.ExportInput(qp.GetInputPort("target_position"), "target_position")
-    index = builder.ExportInput(
-        ref.GetInputPort("ft_sensor.force_W"), "ft_sensor.force_W"
-    )
-    if online:
-        builder.ConnectInput(index, est.GetInputPort("ft_sensor.force_W"))
 
     # The QP reads the references, and the probe's position and velocity they
     # were computed from, from the head of the reference system's "tick"
