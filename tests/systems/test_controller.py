@@ -20,7 +20,13 @@ from vic_drake.control.tank import tank_step
 from vic_drake.errors import VicDrakeError
 from vic_drake.systems.controller import MakeVariableImpedanceController
 from vic_drake.systems.references import ForceReferenceSystem
-from vic_drake.systems.signals import REF_PROBE_POSITION, REF_PROBE_VELOCITY
+from vic_drake.systems.signals import (
+    QP_IN_REFERENCE_TICK,
+    QP_IN_TANK_ENERGY,
+    QP_IN_TARGET,
+    REF_PROBE_POSITION,
+    REF_PROBE_VELOCITY,
+)
 from vic_drake.systems.stiffness_qp import StiffnessQpSystem
 from vic_drake.systems.tank import EnergyTankSystem
 from vic_drake.tissue.phantom import GridPhantom
@@ -231,21 +237,25 @@ def test_qp_reads_the_tanks_energy(phantom):
     for _ in range(3):
         tick(diagram, context)
         np.testing.assert_array_equal(
-            qp.GetInputPort("tank_energy").Eval(qp.GetMyContextFromRoot(context)),
+            qp.get_inputs_input_port().Eval(qp.GetMyContextFromRoot(context))[
+                QP_IN_TANK_ENERGY : QP_IN_TANK_ENERGY + 1
+            ],
             tank.get_energy_output_port().Eval(tank.GetMyContextFromRoot(context)),
         )
 
 
 def test_qp_reads_the_probe_state_the_references_used(phantom):
     """The QP's p, v are the head of the reference tick's record: the Diagram's
-    probe inputs, also after they change."""
+    probe inputs, also after they change; its x_d is the Diagram's input."""
     _, diagram, context = make(phantom, "vs-vf")
     qp = diagram.GetSubsystemByName("stiffness_qp")
     p2, v2 = P_WP + [0.001, -0.002, 0.0005], V_WP + [0.003, 0.0, -0.001]
     for p, v in ((P_WP, V_WP), (p2, v2)):
         diagram.GetInputPort("probe.position").FixValue(context, p)
         diagram.GetInputPort("probe.velocity").FixValue(context, v)
-        head = qp.GetInputPort("reference_tick").Eval(qp.GetMyContextFromRoot(context))
+        inputs = qp.get_inputs_input_port().Eval(qp.GetMyContextFromRoot(context))
+        np.testing.assert_array_equal(inputs[QP_IN_TARGET], X_D)
+        head = inputs[QP_IN_REFERENCE_TICK]
         np.testing.assert_array_equal(head[REF_PROBE_POSITION], p)
         np.testing.assert_array_equal(head[REF_PROBE_VELOCITY], v)
         tick(diagram, context)

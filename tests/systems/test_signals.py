@@ -26,6 +26,10 @@ from vic_drake.systems.signals import (
     MEASURED_POSITION,
     MEASURED_VELOCITY,
     MEASUREMENT_SIZE,
+    QP_IN_REFERENCE_TICK,
+    QP_IN_TANK_ENERGY,
+    QP_IN_TARGET,
+    QP_INPUTS_SIZE,
     QP_TICK_ACTIVE,
     QP_TICK_DAMPING_USED,
     QP_TICK_POSITION_ERROR,
@@ -113,6 +117,10 @@ def test_layouts_cover_their_vectors_once():
         REFERENCES_SIZE,
         REFERENCE_TICK_SIZE,
     )
+    covered = np.zeros(QP_INPUTS_SIZE, int)
+    for part in (QP_IN_TARGET, QP_IN_REFERENCE_TICK, QP_IN_TANK_ENERGY):
+        covered[part] += 1
+    assert np.all(covered == 1) and QP_INPUTS_SIZE == 3 + REFERENCE_TICK_SIZE + 1
 
 
 def test_reference_system_ports_and_layout(phantom):
@@ -185,13 +193,14 @@ def test_reference_system_fault_layout(phantom):
 
 
 def _qp_context(system, refs, energy=0.5):
-    """The QP reads the references with the probe p, v they used (its
-    "reference_tick", the head of the reference system's "tick")."""
+    """The QP reads x_d, the references with the probe p, v they used (the
+    head of the reference system's "tick") and T, as one vector."""
     context = system.CreateDefaultContext()
-    reference_tick = np.concatenate([refs, P_WP, V_WP])
-    for name, value in (("target_position", X_D), ("reference_tick", reference_tick),
-                        ("tank_energy", [energy])):  # fmt: skip
-        system.GetInputPort(name).FixValue(context, value)
+    inputs = np.zeros(QP_INPUTS_SIZE)
+    inputs[QP_IN_TARGET] = X_D
+    inputs[QP_IN_REFERENCE_TICK] = np.concatenate([refs, P_WP, V_WP])
+    inputs[QP_IN_TANK_ENERGY] = energy
+    system.get_inputs_input_port().FixValue(context, inputs)
     return context
 
 
@@ -207,11 +216,7 @@ def _refs(f_ref=(0.0, 0.0, -7.0), f_min=(-15.0, -15.0, -5.0)):
 def test_qp_system_publishes_what_its_tick_used():
     p = params("vs-vf")
     system = StiffnessQpSystem(p)
-    assert ports(system, "input") == {
-        "target_position": 3,
-        "reference_tick": REFERENCE_TICK_SIZE,
-        "tank_energy": 1,
-    }
+    assert ports(system, "input") == {"inputs": QP_INPUTS_SIZE}
     assert ports(system, "output") == {
         "stiffness": 3,
         "damping": 3,

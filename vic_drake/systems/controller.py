@@ -13,10 +13,11 @@ all at ``params.period_s`` (500 Hz by default). The QP reads its references
 and the probe position and velocity they were computed from (the head of
 "force_reference"'s "tick" vector) and T (an element of the tank's "tank"
 record) through two C++ Demultiplexers, "reference_fields" and
-"tank_fields", so that neither read calls Python; the reference system reads
-the three measured inputs as one vector built by a C++ Multiplexer,
-"measurement". All four controllers (CS,
-CF, VS-CF, VS-VF) expose the same ports; see
+"tank_fields", so that neither read calls Python. The reference system and
+the QP each read their inputs as one vector built by a C++ Multiplexer
+("measurement": the three measured inputs; "qp_inputs": x_d, the reference
+tick's head, T). All four controllers (CS, CF, VS-CF, VS-VF) expose the
+same ports; see
 :class:`vic_drake.control.params.ReferenceParams` for how each maps to
 (stiffness, target_force) of the compliance (FDCC) stage.
 """
@@ -35,6 +36,8 @@ from vic_drake.systems.signals import (
     MEASURED_FORCE,
     MEASURED_POSITION,
     MEASURED_VELOCITY,
+    QP_IN_REFERENCE_TICK,
+    QP_IN_TARGET,
     REFERENCE_TICK_SIZE,
     STATUS_FIELDS,
     TANK_ENERGY,
@@ -154,7 +157,20 @@ def MakeVariableImpedanceController(
         index = builder.ExportInput(measurement.get_input_port(i), name)
         if online:
             builder.ConnectInput(index, est.GetInputPort(name))
-    builder.ExportInput(qp.GetInputPort("target_position"), "target_position")
+    # The QP reads x_d, its reference tick and T as one vector, built by a C++
+    # Multiplexer: one port evaluation per tick instead of three.
+    qp_inputs = builder.AddNamedSystem(
+        "qp_inputs",
+        Multiplexer(
+            [
+                QP_IN_TARGET.stop - QP_IN_TARGET.start,
+                QP_IN_REFERENCE_TICK.stop - QP_IN_REFERENCE_TICK.start,
+                1,
+            ]
+        ),
+    )
+    builder.Connect(qp_inputs.get_output_port(0), qp.get_inputs_input_port())
+    builder.ExportInput(qp_inputs.get_input_port(0), "target_position")
 
     # The QP reads the references, and the probe's position and velocity they
     # were computed from, from the head of the reference system's "tick"
@@ -170,7 +186,7 @@ def MakeVariableImpedanceController(
         ),
     )
     builder.Connect(ref.get_tick_output_port(), ref_fields.get_input_port())
-    builder.Connect(ref_fields.get_output_port(0), qp.GetInputPort("reference_tick"))
+    builder.Connect(ref_fields.get_output_port(0), qp_inputs.get_input_port(1))
     # The QP reads T from the "tank" record through a C++ Demultiplexer: the
     # number of the tank's own "tank_energy" port, with no Python call per tick.
     tank_fields = builder.AddNamedSystem(
@@ -178,7 +194,7 @@ def MakeVariableImpedanceController(
     )
     builder.Connect(tank.get_tank_output_port(), tank_fields.get_input_port())
     builder.Connect(
-        tank_fields.get_output_port(TANK_ENERGY), qp.GetInputPort("tank_energy")
+        tank_fields.get_output_port(TANK_ENERGY), qp_inputs.get_input_port(2)
     )
     builder.Connect(qp.get_qp_tick_output_port(), tank.get_qp_tick_input_port())
 

@@ -22,6 +22,10 @@ from vic_drake.control.references import constant_stiffness
 from vic_drake.control.stiffness_qp.problem import make_stiffness_qp_problem
 from vic_drake.control.stiffness_qp.program import StiffnessQp
 from vic_drake.systems.signals import (
+    QP_IN_REFERENCE_TICK,
+    QP_IN_TANK_ENERGY,
+    QP_IN_TARGET,
+    QP_INPUTS_SIZE,
     QP_TICK_ACTIVE,
     QP_TICK_DAMPING_USED,
     QP_TICK_POSITION_ERROR,
@@ -35,7 +39,6 @@ from vic_drake.systems.signals import (
     REF_PENETRATION,
     REF_PROBE_POSITION,
     REF_PROBE_VELOCITY,
-    REFERENCE_TICK_SIZE,
     REFERENCES_SIZE,
     STATUS_FALLBACK_COUNT,
     STATUS_FIELDS,
@@ -53,17 +56,17 @@ __all__ = ["STATUS_FIELDS", "StiffnessQpSystem"]
 class StiffnessQpSystem(LeafSystem):
     """Diagonal stiffness from the QP of eq. 8 (or CS/CF's constant one).
 
-    Input ports:
-        target_position (3): x_d, m.
-        reference_tick (19): the head of ForceReferenceSystem's "tick"
-            output: its "references" (F_ref, F_min, target force, contact),
-            then the probe position p_WP (m) and velocity v_WP (m/s) that
-            tick read (layout: ``REFERENCE_TICK_SIZE`` and the ``REF_*``
-            slices of :mod:`vic_drake.systems.signals`).
-        tank_energy (1): T before this tick, J (EnergyTankSystem's
-            "tank_energy"; in MakeVariableImpedanceController the same
-            number, element TANK_ENERGY of its "tank" record, through a
-            C++ Demultiplexer).
+    Input port:
+        inputs (23): one vector (layout: ``QP_INPUTS_SIZE`` and the
+            ``QP_IN_*`` parts of :mod:`vic_drake.systems.signals`):
+            x_d (3, m); the "reference_tick" (19), the head of
+            ForceReferenceSystem's "tick" output: its "references" (F_ref,
+            F_min, target force, contact), then the probe position p_WP (m)
+            and velocity v_WP (m/s) that tick read (the ``REF_*`` slices);
+            and T before this tick (1, J; EnergyTankSystem's
+            "tank_energy", in MakeVariableImpedanceController element
+            TANK_ENERGY of its "tank" record). The controller Diagram builds
+            it with a C++ Multiplexer ("qp_inputs").
 
     Output ports (the last tick, from state):
         stiffness (3): K, N/m.
@@ -103,14 +106,7 @@ class StiffnessQpSystem(LeafSystem):
             if self._constant is not None
             else StiffnessQp(qp.solver, osqp_eps=qp.osqp_eps).solve
         )
-        ports = {}
-        for name, size in (
-            ("target_position", 3),
-            ("reference_tick", REFERENCE_TICK_SIZE),
-            ("tank_energy", 1),
-        ):
-            ports[name] = self.DeclareVectorInputPort(name, size)
-        self._in_target, self._in_references, self._in_energy = ports.values()
+        self._inputs = self.DeclareVectorInputPort("inputs", QP_INPUTS_SIZE)
         k0 = self._constant if self._constant is not None else self._k_min
         d0 = [2.0 * self._zeta * math.sqrt(k) for k in k0]
         status0 = np.zeros(len(STATUS_FIELDS))
@@ -148,10 +144,11 @@ class StiffnessQpSystem(LeafSystem):
         # On entry discrete_state holds the current state (a LeafSystem copies
         # it in before calling an update handler): K and the fallback count
         # are read there.
-        x_d = self._in_target.Eval(context).tolist()
-        refs = self._in_references.Eval(context).tolist()
+        inputs = self._inputs.Eval(context).tolist()
+        x_d = inputs[QP_IN_TARGET]
+        refs = inputs[QP_IN_REFERENCE_TICK]
         p_WP, v_WP = refs[REF_PROBE_POSITION], refs[REF_PROBE_VELOCITY]
-        energy = self._in_energy.Eval(context).tolist()[0]
+        energy = inputs[QP_IN_TANK_ENERGY]
         i_k, _, _, i_status = self._state_groups
         k_prev = discrete_state.value(i_k).tolist()
         zeta2 = 2.0 * self._zeta
@@ -212,6 +209,9 @@ class StiffnessQpSystem(LeafSystem):
         pen = refs[REF_PENETRATION]
         status[_STATUS_PENETRATION] = pen if math.isfinite(pen) else 0.0
         discrete_state.SetFrom(self._scratch)
+
+    def get_inputs_input_port(self):
+        return self._inputs
 
     def get_stiffness_output_port(self):
         return self._out["stiffness"]
