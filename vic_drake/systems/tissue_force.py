@@ -322,7 +322,7 @@ class TissueForceElement(LeafSystem):
         return self._sample_port
 
     def tip_position(self, context) -> np.ndarray:
-        """p_WT, m, from the body poses input."""
+        """p_WT, m, from the inputs."""
         return self._contact_cache.Eval(context)[0].copy()
 
     def contact(self, context) -> TipContact:
