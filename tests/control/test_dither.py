@@ -90,9 +90,9 @@ def test_dither_frequency_is_bounded_by_the_control_rate():
 
 def _reference_at(system, t):
     context = system.CreateDefaultContext()
-    system.GetInputPort("probe.position").FixValue(context, [0.0, 0.0, 0.094])
-    system.GetInputPort("probe.velocity").FixValue(context, [0.0, 0.0, 0.0])
-    system.GetInputPort("ft_sensor.force_W").FixValue(context, [0.0, 0.0, -6.0])
+    # p_WP, v_WP, the F/T force.
+    measurement = [0.0, 0.0, 0.094, 0.0, 0.0, 0.0, 0.0, 0.0, -6.0]
+    system.GetInputPort("measurement").FixValue(context, measurement)
     context.SetTime(t)
     return system.GetOutputPort("references").Eval(context)[2]
 

@@ -20,6 +20,13 @@ from vic_drake.control.tank import tank_step
 from vic_drake.errors import VicDrakeError
 from vic_drake.systems.controller import MakeVariableImpedanceController
 from vic_drake.systems.references import ForceReferenceSystem
+from vic_drake.systems.signals import (
+    QP_IN_REFERENCE_TICK,
+    QP_IN_TANK_ENERGY,
+    QP_IN_TARGET,
+    REF_PROBE_POSITION,
+    REF_PROBE_VELOCITY,
+)
 from vic_drake.systems.stiffness_qp import StiffnessQpSystem
 from vic_drake.systems.tank import EnergyTankSystem
 from vic_drake.tissue.phantom import GridPhantom
@@ -217,9 +224,9 @@ def test_target_force_is_cf_only_and_zero_on_a_fault(phantom):
             for i in range(system.num_input_ports())
         )
         context = system.CreateDefaultContext()
-        system.get_probe_position_input_port().FixValue(context, P_WP)
-        system.get_probe_velocity_input_port().FixValue(context, V_WP)
-        system.get_measured_force_input_port().FixValue(context, F_W)
+        system.get_measurement_input_port().FixValue(
+            context, np.concatenate([P_WP, V_WP, F_W])
+        )
         np.testing.assert_array_equal(port.Eval(context), [0.0] * 3)
 
 
@@ -230,9 +237,30 @@ def test_qp_reads_the_tanks_energy(phantom):
     for _ in range(3):
         tick(diagram, context)
         np.testing.assert_array_equal(
-            qp.GetInputPort("tank_energy").Eval(qp.GetMyContextFromRoot(context)),
+            qp.get_inputs_input_port().Eval(qp.GetMyContextFromRoot(context))[
+                QP_IN_TANK_ENERGY : QP_IN_TANK_ENERGY + 1
+            ],
             tank.get_energy_output_port().Eval(tank.GetMyContextFromRoot(context)),
         )
+
+
+def test_qp_reads_the_probe_state_the_references_used(phantom):
+    """The QP's p, v are the head of the reference tick's record: the Diagram's
+    probe inputs, also after they change; its x_d is the Diagram's input."""
+    _, diagram, context = make(phantom, "vs-vf")
+    qp = diagram.GetSubsystemByName("stiffness_qp")
+    p2, v2 = P_WP + [0.001, -0.002, 0.0005], V_WP + [0.003, 0.0, -0.001]
+    for p, v in ((P_WP, V_WP), (p2, v2)):
+        diagram.GetInputPort("probe.position").FixValue(context, p)
+        diagram.GetInputPort("probe.velocity").FixValue(context, v)
+        inputs = qp.get_inputs_input_port().Eval(qp.GetMyContextFromRoot(context))
+        np.testing.assert_array_equal(inputs[QP_IN_TARGET], X_D)
+        head = inputs[QP_IN_REFERENCE_TICK]
+        np.testing.assert_array_equal(head[REF_PROBE_POSITION], p)
+        np.testing.assert_array_equal(head[REF_PROBE_VELOCITY], v)
+        tick(diagram, context)
+        record = out(diagram, context, "tick_record")
+        np.testing.assert_array_equal(record[:6], [*p, *v])
 
 
 def test_osqp_system_matches_exact_system(phantom):

@@ -119,3 +119,41 @@ def test_one_sample_equals_the_pure_tare_in_any_orientation():
             R_WS @ expected[3:],
             atol=1e-14,
         )
+
+
+def test_plant_state_input_gives_the_body_poses_numbers():
+    """Built with the plant, the sensor reads its body's orientation from the
+    plant's state vector: the same readings as from the body poses list."""
+    from tests.systems.test_body_reader import free_and_lifted_plant
+
+    plant, plant_context = free_and_lifted_plant()
+    kw = dict(
+        weld_joint_index=JointIndex(0), child_body_index=BodyIndex(1),
+        X_CS=RigidTransform(RotationMatrix.MakeZRotation(0.4)), distal_mass_kg=0.12,
+        p_SScm=[0.003, 0.01, 0.02], lag_samples=1, bias=[0, 0, 0, 0.1, -0.2, 0.3],
+    )  # fmt: skip
+    lists, state = ForceTorqueSensor(**kw), ForceTorqueSensor(plant=plant, **kw)
+    with pytest.raises(VicDrakeError, match="no 'body_poses' input port"):
+        state.get_body_poses_input_port()
+    with pytest.raises(VicDrakeError, match="no 'plant_state' input port"):
+        lists.get_plant_state_input_port()
+    c_lists, c_state = lists.CreateDefaultContext(), state.CreateDefaultContext()
+    lists.get_body_poses_input_port().FixValue(
+        c_lists, plant.get_body_poses_output_port().Eval(plant_context)
+    )
+    state.get_plant_state_input_port().FixValue(
+        c_state, plant.get_state_output_port().Eval(plant_context)
+    )
+    for k in range(3):
+        reaction = [SpatialForce([0.01 * k, -0.02, 0.03], [1.0, -2.0 * k, 3.0])]
+        for system, context in ((state, c_state), (lists, c_lists)):
+            system.get_reaction_forces_input_port().FixValue(context, reaction)
+            context.SetDiscreteState(system.EvalUniquePeriodicDiscreteUpdate(context))
+        np.testing.assert_array_equal(state.tared_wrench(c_state),
+                                      lists.tared_wrench(c_lists))  # fmt: skip
+        for port in ("wrench_S", "force_W"):
+            np.testing.assert_array_equal(
+                state.GetOutputPort(port).Eval(c_state),
+                lists.GetOutputPort(port).Eval(c_lists),
+            )
+    assert np.any(state.get_force_output_port().Eval(c_state) != 0)

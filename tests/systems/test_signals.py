@@ -22,6 +22,14 @@ from vic_drake.control.tank import TankStep, tank_step
 from vic_drake.systems.references import ForceReferenceSystem
 from vic_drake.systems.signals import (
     CONTACT_FIELDS,
+    MEASURED_FORCE,
+    MEASURED_POSITION,
+    MEASURED_VELOCITY,
+    MEASUREMENT_SIZE,
+    QP_IN_REFERENCE_TICK,
+    QP_IN_TANK_ENERGY,
+    QP_IN_TARGET,
+    QP_INPUTS_SIZE,
     QP_TICK_ACTIVE,
     QP_TICK_DAMPING_USED,
     QP_TICK_POSITION_ERROR,
@@ -34,8 +42,11 @@ from vic_drake.systems.signals import (
     REF_FORCE_REFERENCE,
     REF_IN_CONTACT,
     REF_PENETRATION,
+    REF_PROBE_POSITION,
+    REF_PROBE_VELOCITY,
     REF_SURFACE_VELOCITY,
     REF_TARGET_FORCE,
+    REFERENCE_TICK_SIZE,
     REFERENCES_SIZE,
     STATUS_FIELDS,
     TANK_FIELDS,
@@ -90,16 +101,32 @@ def test_layouts_cover_their_vectors_once():
                  QP_TICK_DAMPING_USED, QP_TICK_ACTIVE):  # fmt: skip
         covered[part] += 1
     assert np.all(covered == 1)
+    # The reference system's measurement: the tick record's p, v, f.
+    parts = (MEASURED_POSITION, MEASURED_VELOCITY, MEASURED_FORCE)
+    assert [(part.start, part.stop) for part in parts] == [(0, 3), (3, 6), (6, 9)]
+    assert MEASUREMENT_SIZE == 9 and TICK_RECORD_FIELDS[6:9] == (
+        "force_x_N",
+        "force_y_N",
+        "force_z_N",
+    )
+    # The QP's reference_tick: the references, then the tick record's p, v.
+    record = REFERENCE_TICK_SIZE - REFERENCES_SIZE
+    assert TICK_RECORD_FIELDS[:record] == ("x_m", "y_m", "z_m", "vx_m_per_s",
+                                           "vy_m_per_s", "vz_m_per_s")  # fmt: skip
+    assert (REF_PROBE_POSITION.start, REF_PROBE_VELOCITY.stop) == (
+        REFERENCES_SIZE,
+        REFERENCE_TICK_SIZE,
+    )
+    covered = np.zeros(QP_INPUTS_SIZE, int)
+    for part in (QP_IN_TARGET, QP_IN_REFERENCE_TICK, QP_IN_TANK_ENERGY):
+        covered[part] += 1
+    assert np.all(covered == 1) and QP_INPUTS_SIZE == 3 + REFERENCE_TICK_SIZE + 1
 
 
 def test_reference_system_ports_and_layout(phantom):
     p = params("vs-cf")
     system = ForceReferenceSystem(p, phantom=phantom)
-    assert ports(system, "input") == {
-        "probe.position": 3,
-        "probe.velocity": 3,
-        "ft_sensor.force_W": 3,
-    }
+    assert ports(system, "input") == {"measurement": MEASUREMENT_SIZE}
     assert ports(system, "output") == {
         "target_force": 3,
         "references": REFERENCES_SIZE,
@@ -111,9 +138,9 @@ def test_reference_system_ports_and_layout(phantom):
         "tick": REFERENCES_SIZE + len(TICK_RECORD_FIELDS) + 13,
     }
     context = system.CreateDefaultContext()
-    system.get_probe_position_input_port().FixValue(context, P_WP)
-    system.get_probe_velocity_input_port().FixValue(context, V_WP)
-    system.get_measured_force_input_port().FixValue(context, F_W)
+    system.get_measurement_input_port().FixValue(
+        context, np.concatenate([P_WP, V_WP, F_W])
+    )
     refs = system.get_references_output_port().Eval(context)
     # The "tick" vector (what the controller Diagram hands the QP through a
     # Demultiplexer) starts with the references, then the record.
@@ -123,6 +150,9 @@ def test_reference_system_ports_and_layout(phantom):
         whole[REFERENCES_SIZE : REFERENCES_SIZE + len(TICK_RECORD_FIELDS)],
         [*P_WP, *V_WP, *F_W, KAPPA, LAM],
     )
+    # Its head is the QP's reference_tick: the measurement the references used.
+    np.testing.assert_array_equal(whole[REF_PROBE_POSITION], P_WP)
+    np.testing.assert_array_equal(whole[REF_PROBE_VELOCITY], V_WP)
     expected = force_references(contact=True, kappa=KAPPA, lam=LAM, eps_dot=-V_WP[2],
                                 beta=BETA, ref=p.reference, qp=p.qp)  # fmt: skip
     np.testing.assert_allclose(
@@ -153,9 +183,9 @@ def test_reference_system_fault_layout(phantom):
     p = params("vs-vf")
     system = ForceReferenceSystem(p, phantom=phantom)
     context = system.CreateDefaultContext()
-    system.get_probe_position_input_port().FixValue(context, [0.0, math.nan, 0.1])
-    system.get_probe_velocity_input_port().FixValue(context, V_WP)
-    system.get_measured_force_input_port().FixValue(context, F_W)
+    system.get_measurement_input_port().FixValue(
+        context, np.concatenate([[0.0, math.nan, 0.1], V_WP, F_W])
+    )
     refs = system.get_references_output_port().Eval(context)
     assert refs[REF_FAULT] == 1.0 and refs[REF_IN_CONTACT] == 0.0
     np.testing.assert_array_equal(refs[REF_FORCE_REFERENCE], [0.0, 0.0, 0.0])
@@ -163,11 +193,14 @@ def test_reference_system_fault_layout(phantom):
 
 
 def _qp_context(system, refs, energy=0.5):
+    """The QP reads x_d, the references with the probe p, v they used (the
+    head of the reference system's "tick") and T, as one vector."""
     context = system.CreateDefaultContext()
-    for name, value in (("probe.position", P_WP), ("probe.velocity", V_WP),
-                        ("target_position", X_D), ("references", refs),
-                        ("tank_energy", [energy])):  # fmt: skip
-        system.GetInputPort(name).FixValue(context, value)
+    inputs = np.zeros(QP_INPUTS_SIZE)
+    inputs[QP_IN_TARGET] = X_D
+    inputs[QP_IN_REFERENCE_TICK] = np.concatenate([refs, P_WP, V_WP])
+    inputs[QP_IN_TANK_ENERGY] = energy
+    system.get_inputs_input_port().FixValue(context, inputs)
     return context
 
 
@@ -183,13 +216,7 @@ def _refs(f_ref=(0.0, 0.0, -7.0), f_min=(-15.0, -15.0, -5.0)):
 def test_qp_system_publishes_what_its_tick_used():
     p = params("vs-vf")
     system = StiffnessQpSystem(p)
-    assert ports(system, "input") == {
-        "probe.position": 3,
-        "probe.velocity": 3,
-        "target_position": 3,
-        "references": REFERENCES_SIZE,
-        "tank_energy": 1,
-    }
+    assert ports(system, "input") == {"inputs": QP_INPUTS_SIZE}
     assert ports(system, "output") == {
         "stiffness": 3,
         "damping": 3,

@@ -296,3 +296,52 @@ def test_the_stored_sample_is_the_contact_the_next_plant_step_uses():
         np.testing.assert_array_equal(forces[0].F_Bq_W.translational(), contact.force_W)
         pressed += contact.force_N > 1.0
     assert pressed >= 5  # the comparison covered the tip in the tissue
+
+
+def test_plant_state_input_gives_the_list_ports_numbers():
+    """Built with the plant, the element reads its state vector: every output
+    is bit-identical to the element fed the plant's pose and velocity lists."""
+    from tests.systems.test_body_reader import free_and_lifted_plant
+    from vic_drake.errors import VicDrakeError
+    from vic_drake.tissue import RelaxationParams
+
+    plant, plant_context = free_and_lifted_plant()
+    kw = dict(
+        indenter_body_index=BodyIndex(1), p_BT=np.array([0.001, -0.002, 0.07]),
+        phantom_body_index=BodyIndex(2), friction_coefficient=0.3, along_normal=True,
+        relaxation=RelaxationParams(fractions=(0.1, 0.2), time_constants_s=(0.05, 1.0)),
+        update_period_s=0.002,
+    )  # fmt: skip
+    lists = TissueForceElement(_plane_phantom(), **kw)
+    state = TissueForceElement(_plane_phantom(), plant=plant, **kw)
+    with pytest.raises(VicDrakeError, match="no 'body_poses' input port"):
+        state.get_body_poses_input_port()
+    with pytest.raises(VicDrakeError, match="no 'plant_state' input port"):
+        lists.get_plant_state_input_port()
+    c_lists, c_state = lists.CreateDefaultContext(), state.CreateDefaultContext()
+    lists.get_body_poses_input_port().FixValue(
+        c_lists, plant.get_body_poses_output_port().Eval(plant_context)
+    )
+    lists.get_body_spatial_velocities_input_port().FixValue(
+        c_lists, plant.get_body_spatial_velocities_output_port().Eval(plant_context)
+    )
+    state.get_plant_state_input_port().FixValue(
+        c_state, plant.get_state_output_port().Eval(plant_context)
+    )
+    assert state.get_penetration_output_port().Eval(c_state)[0] > 0  # In contact.
+    for _ in range(3):  # Ticks move the relaxation branches.
+        for port in ("tissue.force_W", "tissue.penetration", "tissue.surface_z",
+                     "probe.position", "probe.velocity", "tissue.sample"):  # fmt: skip
+            np.testing.assert_array_equal(
+                state.GetOutputPort(port).Eval(c_state),
+                lists.GetOutputPort(port).Eval(c_lists),
+            )
+        for a, b in zip(
+            state.get_spatial_forces_output_port().Eval(c_state),
+            lists.get_spatial_forces_output_port().Eval(c_lists),
+        ):
+            np.testing.assert_array_equal(a.F_Bq_W.get_coeffs(), b.F_Bq_W.get_coeffs())
+            np.testing.assert_array_equal(a.p_BoBq_B, b.p_BoBq_B)
+        for system, context in ((state, c_state), (lists, c_lists)):
+            update = system.EvalUniquePeriodicDiscreteUpdate(context)
+            context.get_mutable_discrete_state().SetFrom(update)

@@ -124,15 +124,12 @@ def MakeStation(
             along_normal=params.tissue_force_along_normal,
             relaxation=params.relaxation,
             update_period_s=params.plant.time_step,
+            plant=plant,
         ),
     )
-    builder.Connect(
-        plant.get_body_poses_output_port(), tissue.get_body_poses_input_port()
-    )
-    builder.Connect(
-        plant.get_body_spatial_velocities_output_port(),
-        tissue.get_body_spatial_velocities_input_port(),
-    )
+    # The element and the sensor read one or two bodies: from the plant's
+    # state vector, not the lists of every body's pose and velocity.
+    builder.Connect(plant.get_state_output_port(), tissue.get_plant_state_input_port())
     builder.Connect(
         tissue.get_spatial_forces_output_port(),
         plant.get_applied_spatial_force_input_port(),
@@ -164,14 +161,13 @@ def MakeStation(
             noise_std=noise_std,
             bias=np.concatenate([np.zeros(3), params.sensor_bias_N]),
             gravity_W=[0, 0, -params.gravity_m_per_s2],
+            plant=plant,
         ),
     )
     builder.Connect(
         plant.get_reaction_forces_output_port(), sensor.get_reaction_forces_input_port()
     )
-    builder.Connect(
-        plant.get_body_poses_output_port(), sensor.get_body_poses_input_port()
-    )
+    builder.Connect(plant.get_state_output_port(), sensor.get_plant_state_input_port())
     if np.any(noise_std > 0):
         noise = builder.AddNamedSystem(
             "ft_sensor_noise",

@@ -10,10 +10,14 @@ named "variable_impedance_controller" composing
 - "energy_tank" (:class:`EnergyTankSystem`): T, power, sigma, enabled,
 
 all at ``params.period_s`` (500 Hz by default). The QP reads its references
-(the head of "force_reference"'s "tick" vector) and T (an element of the
-tank's "tank" record) through two C++ Demultiplexers, "reference_fields"
-and "tank_fields", so that neither read calls Python. All four controllers (CS,
-CF, VS-CF, VS-VF) expose the same ports; see
+and the probe position and velocity they were computed from (the head of
+"force_reference"'s "tick" vector) and T (an element of the tank's "tank"
+record) through two C++ Demultiplexers, "reference_fields" and
+"tank_fields", so that neither read calls Python. The reference system and
+the QP each read their inputs as one vector built by a C++ Multiplexer
+("measurement": the three measured inputs; "qp_inputs": x_d, the reference
+tick's head, T). All four controllers (CS, CF, VS-CF, VS-VF) expose the
+same ports; see
 :class:`vic_drake.control.params.ReferenceParams` for how each maps to
 (stiffness, target_force) of the compliance (FDCC) stage.
 """
@@ -21,7 +25,7 @@ CF, VS-CF, VS-VF) expose the same ports; see
 from __future__ import annotations
 
 from pydrake.systems.framework import Diagram, DiagramBuilder
-from pydrake.systems.primitives import Demultiplexer
+from pydrake.systems.primitives import Demultiplexer, Multiplexer
 
 from vic_drake.control.params import ControllerParams
 from vic_drake.errors import VicDrakeError
@@ -29,7 +33,12 @@ from vic_drake.estimation.online import OnlineEstimatorParams
 from vic_drake.systems.online_estimator import OnlineEstimatorSystem
 from vic_drake.systems.references import ForceReferenceSystem
 from vic_drake.systems.signals import (
-    REFERENCES_SIZE,
+    MEASURED_FORCE,
+    MEASURED_POSITION,
+    MEASURED_VELOCITY,
+    QP_IN_REFERENCE_TICK,
+    QP_IN_TARGET,
+    REFERENCE_TICK_SIZE,
     STATUS_FIELDS,
     TANK_ENERGY,
     TANK_FIELDS,
@@ -133,28 +142,51 @@ def MakeVariableImpedanceController(
     qp = builder.AddNamedSystem("stiffness_qp", StiffnessQpSystem(params))
     tank = builder.AddNamedSystem("energy_tank", EnergyTankSystem(params))
 
-    for name in ("probe.position", "probe.velocity"):
-        index = builder.ExportInput(ref.GetInputPort(name), name)
-        builder.ConnectInput(index, qp.GetInputPort(name))
+    # The reference system reads the three measured vectors as one, built by
+    # a C++ Multiplexer: one port evaluation per tick instead of three.
+    parts = {
+        "probe.position": MEASURED_POSITION,
+        "probe.velocity": MEASURED_VELOCITY,
+        "ft_sensor.force_W": MEASURED_FORCE,
+    }
+    measurement = builder.AddNamedSystem(
+        "measurement", Multiplexer([part.stop - part.start for part in parts.values()])
+    )
+    builder.Connect(measurement.get_output_port(0), ref.get_measurement_input_port())
+    for i, name in enumerate(parts):
+        index = builder.ExportInput(measurement.get_input_port(i), name)
         if online:
             builder.ConnectInput(index, est.GetInputPort(name))
-    builder.ExportInput(qp.GetInputPort("target_position"), "target_position")
-    index = builder.ExportInput(
-        ref.GetInputPort("ft_sensor.force_W"), "ft_sensor.force_W"
+    # The QP reads x_d, its reference tick and T as one vector, built by a C++
+    # Multiplexer: one port evaluation per tick instead of three.
+    qp_inputs = builder.AddNamedSystem(
+        "qp_inputs",
+        Multiplexer(
+            [
+                QP_IN_TARGET.stop - QP_IN_TARGET.start,
+                QP_IN_REFERENCE_TICK.stop - QP_IN_REFERENCE_TICK.start,
+                1,
+            ]
+        ),
     )
-    if online:
-        builder.ConnectInput(index, est.GetInputPort("ft_sensor.force_W"))
+    builder.Connect(qp_inputs.get_output_port(0), qp.get_inputs_input_port())
+    builder.ExportInput(qp_inputs.get_input_port(0), "target_position")
 
-    # The QP reads the references from the reference system's "tick" vector
-    # through a C++ Demultiplexer: no Python output callback per tick.
+    # The QP reads the references, and the probe's position and velocity they
+    # were computed from, from the head of the reference system's "tick"
+    # vector through a C++ Demultiplexer: no Python output callback per tick
+    # and no Eval of the probe ports of its own.
     ref_fields = builder.AddNamedSystem(
         "reference_fields",
         Demultiplexer(
-            [REFERENCES_SIZE, ref.get_tick_output_port().size() - REFERENCES_SIZE]
+            [
+                REFERENCE_TICK_SIZE,
+                ref.get_tick_output_port().size() - REFERENCE_TICK_SIZE,
+            ]
         ),
     )
     builder.Connect(ref.get_tick_output_port(), ref_fields.get_input_port())
-    builder.Connect(ref_fields.get_output_port(0), qp.GetInputPort("references"))
+    builder.Connect(ref_fields.get_output_port(0), qp_inputs.get_input_port(1))
     # The QP reads T from the "tank" record through a C++ Demultiplexer: the
     # number of the tank's own "tank_energy" port, with no Python call per tick.
     tank_fields = builder.AddNamedSystem(
@@ -162,7 +194,7 @@ def MakeVariableImpedanceController(
     )
     builder.Connect(tank.get_tank_output_port(), tank_fields.get_input_port())
     builder.Connect(
-        tank_fields.get_output_port(TANK_ENERGY), qp.GetInputPort("tank_energy")
+        tank_fields.get_output_port(TANK_ENERGY), qp_inputs.get_input_port(2)
     )
     builder.Connect(qp.get_qp_tick_output_port(), tank.get_qp_tick_input_port())
 

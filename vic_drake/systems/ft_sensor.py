@@ -37,11 +37,13 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.math import RigidTransform
 from pydrake.multibody.math import SpatialForce
+from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import BodyIndex, JointIndex
 from pydrake.systems.framework import LeafSystem
 
 from vic_drake.errors import VicDrakeError
 from vic_drake.paper import GRAVITY_M_PER_S2
+from vic_drake.systems.body_reader import PlantBodyReader, port_or_error
 
 
 def tared_sensor_wrench(
@@ -79,7 +81,12 @@ class ForceTorqueSensor(LeafSystem):
     Input ports:
         reaction_forces: ``list[SpatialForce]`` (the plant's reaction forces
             port, indexed by joint index).
-        body_poses: ``list[RigidTransform]`` (the plant's body poses port).
+        body_poses: ``list[RigidTransform]`` (the plant's body poses port);
+            built with ``plant``, instead:
+        plant_state: (n_q + n_v) the plant's state port [q; v], from which
+            the sensor body's pose is computed in a private context of
+            ``plant`` (the same numbers as the list port; the plant's default
+            parameters).
         noise: (6,) standard-normal samples (e.g. a RandomSource); if left
             unconnected the reading is noise free.
     Output ports:
@@ -104,6 +111,7 @@ class ForceTorqueSensor(LeafSystem):
         noise_std=(0.0,) * 6,
         bias=(0.0,) * 6,
         gravity_W=(0.0, 0.0, -GRAVITY_M_PER_S2),
+        plant: MultibodyPlant | None = None,
     ):
         """
         Args:
@@ -117,6 +125,9 @@ class ForceTorqueSensor(LeafSystem):
             noise_std: per-component noise std of ``[tau; f]`` (N m, N).
             bias: constant offset added to ``[tau; f]`` after the delay.
             gravity_W: gravity in W, m/s^2.
+            plant: the finalized MultibodyPlant of the joint and body: the
+                sensor then reads the plant's state (input "plant_state")
+                instead of the body poses list (see the class doc).
         """
         super().__init__()
         if not (np.isfinite(period_s) and period_s > 0):
@@ -144,9 +155,16 @@ class ForceTorqueSensor(LeafSystem):
         self._reaction_port = self.DeclareAbstractInputPort(
             "reaction_forces", AbstractValue.Make([SpatialForce()])
         )
-        self._poses_port = self.DeclareAbstractInputPort(
-            "body_poses", AbstractValue.Make([RigidTransform()])
-        )
+        self._poses_port = self._state_port = None
+        if plant is None:
+            self._poses_port = self.DeclareAbstractInputPort(
+                "body_poses", AbstractValue.Make([RigidTransform()])
+            )
+        else:
+            self._reader = PlantBodyReader(plant, (child_body_index,), velocities=False)
+            self._state_port = self.DeclareVectorInputPort(
+                "plant_state", self._reader.num_states
+            )
         self._noise_port = self.DeclareVectorInputPort("noise", 6)
         self._buffer = self.DeclareDiscreteState(6 * self._n)
         self._wrench = self.DeclareDiscreteState(self._bias.copy())
@@ -159,7 +177,10 @@ class ForceTorqueSensor(LeafSystem):
         return self._reaction_port
 
     def get_body_poses_input_port(self):
-        return self._poses_port
+        return port_or_error(self._poses_port, "body_poses", "a plant")
+
+    def get_plant_state_input_port(self):
+        return port_or_error(self._state_port, "plant_state", "no plant")
 
     def get_noise_input_port(self):
         return self._noise_port
@@ -170,9 +191,16 @@ class ForceTorqueSensor(LeafSystem):
     def get_force_output_port(self):
         return self._force_port
 
+    def _R_WC(self, context) -> np.ndarray:
+        """The orientation of the sensor body C in W, from the inputs."""
+        if self._state_port is None:
+            X_WC = self._poses_port.Eval(context)[self._child]
+        else:
+            (X_WC,) = self._reader(self._state_port.Eval(context))
+        return X_WC.rotation().matrix()
+
     def _R_WS(self, context) -> np.ndarray:
-        X_WC = self._poses_port.Eval(context)[self._child]
-        return X_WC.rotation().matrix() @ self._R_CS
+        return self._R_WC(context) @ self._R_CS
 
     def tared_wrench(self, context) -> np.ndarray:
         """The noise-free, undelayed tared wrench ``[tau; f]`` in S now."""
@@ -186,7 +214,7 @@ class ForceTorqueSensor(LeafSystem):
         )
 
     def _update(self, context, discrete_state):
-        R_WC = self._poses_port.Eval(context)[self._child].rotation().matrix()
+        R_WC = self._R_WC(context)
         R_WS = R_WC if self._identity_CS else R_WC @ self._R_CS
         F_S = self._reaction_port.Eval(context)[self._joint].get_coeffs()
         # = tared_sensor_wrench(F_S, R_WS, ...), one product per tick.

@@ -37,6 +37,10 @@ from vic_drake.control.references import (
 from vic_drake.errors import VicDrakeError
 from vic_drake.estimation.online import OUTPUT_FIELDS as ESTIMATE_FIELDS
 from vic_drake.systems.signals import (
+    MEASURED_FORCE,
+    MEASURED_POSITION,
+    MEASURED_VELOCITY,
+    MEASUREMENT_SIZE,
     REF_CONTACT,
     REF_FAULT,
     REF_FORCE_MIN,
@@ -70,10 +74,12 @@ def _array(values: list) -> np.ndarray:
 class ForceReferenceSystem(LeafSystem):
     """Force references of the selected controller (CS, CF, VS-CF, VS-VF).
 
-    Input ports:
-        probe.position (3): probe tip p_WP, m.
-        probe.velocity (3): v_WP, m/s.
-        ft_sensor.force_W (3): F/T force in W, N, sensor convention.
+    Input port:
+        measurement (9): probe tip p_WP (m), its velocity v_WP (m/s) and the
+            F/T force in W (N, sensor convention), one vector (layout:
+            ``MEASUREMENT_SIZE`` and the ``MEASURED_*`` slices of
+            :mod:`vic_drake.systems.signals`; the controller Diagram builds
+            it from its three inputs with a C++ Multiplexer).
 
     Output ports (direct feedthrough of the current inputs):
         target_force (3): force the FDCC stage tracks, N (CF only; a
@@ -148,9 +154,9 @@ class ForceReferenceSystem(LeafSystem):
         self._dt = float(params.period_s)
         ref = params.reference
         self._moving_average = ref.surface_velocity_mode == "moving_average"
-        self._position_port = self.DeclareVectorInputPort("probe.position", 3)
-        self._velocity_port = self.DeclareVectorInputPort("probe.velocity", 3)
-        self._force_port = self.DeclareVectorInputPort("ft_sensor.force_W", 3)
+        self._measurement_port = self.DeclareVectorInputPort(
+            "measurement", MEASUREMENT_SIZE
+        )
         self._estimate_port = (
             self.DeclareVectorInputPort("tissue.estimate", len(ESTIMATE_FIELDS))
             if self._online
@@ -238,9 +244,10 @@ class ForceReferenceSystem(LeafSystem):
     def _evaluate(self, context) -> np.ndarray:
         """The tick now, as one array: the references (``_REFERENCES``), the
         tick record (``_RECORD``), then the new filter state."""
-        p_WP = self._position_port.Eval(context).tolist()
-        v_WP = self._velocity_port.Eval(context).tolist()
-        f_W = self._force_port.Eval(context).tolist()
+        measured = self._measurement_port.Eval(context).tolist()
+        p_WP = measured[MEASURED_POSITION]
+        v_WP = measured[MEASURED_VELOCITY]
+        f_W = measured[MEASURED_FORCE]
         filt = context.get_discrete_state(self._filter_index).value().tolist()
         # A sum of floats is finite iff every term is (inf - inf = nan).
         if not math.isfinite(sum(p_WP) + sum(v_WP) + sum(f_W)):
@@ -301,14 +308,8 @@ class ForceReferenceSystem(LeafSystem):
             view[:] = tick[part]
         discrete_state.SetFrom(self._scratch)
 
-    def get_probe_position_input_port(self):
-        return self._position_port
-
-    def get_probe_velocity_input_port(self):
-        return self._velocity_port
-
-    def get_measured_force_input_port(self):
-        return self._force_port
+    def get_measurement_input_port(self):
+        return self._measurement_port
 
     def get_force_reference_output_port(self):
         return self._outputs["force_reference"]

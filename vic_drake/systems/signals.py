@@ -4,11 +4,14 @@ Most controller signals are ports of their own. A few vectors stay packed
 (see docs/decisions.md, "Controller signals") and are described here, the
 one place both their writer and their readers take the layout from:
 
-- ``references`` (ForceReferenceSystem -> StiffnessQpSystem): the tick's
-  references, computed with direct feedthrough from the current measurement
-  in one cache entry. One port keeps the QP's update at one evaluation of a
-  Python output per tick (a port per signal would add one Python callback
-  each).
+- ``measurement`` (ForceReferenceSystem's input): what a tick reads,
+  one vector (one port evaluation per tick).
+- ``references`` (ForceReferenceSystem): the tick's references, computed
+  with direct feedthrough from the current measurement; with the probe
+  position and velocity the tick read, the head of its "tick" vector, they
+  are the ``reference_tick`` part of StiffnessQpSystem's ``inputs`` vector
+  (one port evaluation per tick: C++ Demultiplexers and a Multiplexer in
+  the controller Diagram).
 - ``contact`` (ForceReferenceSystem, state of the last tick): the contact
   part of ``references``.
 - ``qp_tick`` (StiffnessQpSystem -> EnergyTankSystem): what the QP's last
@@ -47,6 +50,13 @@ TICK_RECORD_FIELDS = (
 )
 TICK_RECORD_SIZE = len(TICK_RECORD_FIELDS)
 
+#: ForceReferenceSystem's "measurement" input: what a tick reads, the first
+#: nine :data:`TICK_RECORD_FIELDS` (p_WP, m; v_WP, m/s; F/T force in W, N).
+MEASUREMENT_SIZE = 9
+MEASURED_POSITION = slice(0, 3)
+MEASURED_VELOCITY = slice(3, 6)
+MEASURED_FORCE = slice(6, 9)
+
 #: The "references" port: F_ref (3, N), F_min (3, N), the FDCC target force
 #: (3, N), then the :data:`CONTACT_FIELDS`.
 REFERENCES_SIZE = 9 + CONTACT_SIZE
@@ -58,6 +68,23 @@ REF_IN_CONTACT = 9 + CONTACT_FIELDS.index("in_contact")
 REF_PENETRATION = 9 + CONTACT_FIELDS.index("penetration_m")
 REF_FAULT = 9 + CONTACT_FIELDS.index("fault")
 REF_SURFACE_VELOCITY = 9 + CONTACT_FIELDS.index("surface_velocity_m_per_s")
+
+#: The "reference_tick" part of StiffnessQpSystem's inputs: the head of
+#: ForceReferenceSystem's "tick" output, i.e. the "references" then the
+#: probe position p_WP (3, m) and velocity v_WP (3, m/s) the tick read (the
+#: first six :data:`TICK_RECORD_FIELDS`): the QP uses the measurement its
+#: references were computed from.
+REFERENCE_TICK_SIZE = REFERENCES_SIZE + 6
+REF_PROBE_POSITION = slice(REFERENCES_SIZE, REFERENCES_SIZE + 3)
+REF_PROBE_VELOCITY = slice(REFERENCES_SIZE + 3, REFERENCE_TICK_SIZE)
+
+#: StiffnessQpSystem's one "inputs" vector (a C++ Multiplexer builds it in
+#: the controller Diagram): the target position x_d (3, m), the
+#: "reference_tick" above, then the tank's energy T before the tick (1, J).
+QP_IN_TARGET = slice(0, 3)
+QP_IN_REFERENCE_TICK = slice(3, 3 + REFERENCE_TICK_SIZE)
+QP_IN_TANK_ENERGY = QP_IN_REFERENCE_TICK.stop
+QP_INPUTS_SIZE = QP_IN_TANK_ENERGY + 1
 
 #: The "qp_tick" port: the QP's last tick as the tank integrates it.
 #: e = x_d - x (3, m), e_dot = -x_dot (3, m/s), K (3, N/m), the damping D

@@ -22,6 +22,10 @@ from vic_drake.control.references import constant_stiffness
 from vic_drake.control.stiffness_qp.problem import make_stiffness_qp_problem
 from vic_drake.control.stiffness_qp.program import StiffnessQp
 from vic_drake.systems.signals import (
+    QP_IN_REFERENCE_TICK,
+    QP_IN_TANK_ENERGY,
+    QP_IN_TARGET,
+    QP_INPUTS_SIZE,
     QP_TICK_ACTIVE,
     QP_TICK_DAMPING_USED,
     QP_TICK_POSITION_ERROR,
@@ -33,6 +37,8 @@ from vic_drake.systems.signals import (
     REF_FORCE_REFERENCE,
     REF_IN_CONTACT,
     REF_PENETRATION,
+    REF_PROBE_POSITION,
+    REF_PROBE_VELOCITY,
     REFERENCES_SIZE,
     STATUS_FALLBACK_COUNT,
     STATUS_FIELDS,
@@ -50,16 +56,17 @@ __all__ = ["STATUS_FIELDS", "StiffnessQpSystem"]
 class StiffnessQpSystem(LeafSystem):
     """Diagonal stiffness from the QP of eq. 8 (or CS/CF's constant one).
 
-    Input ports:
-        probe.position (3): p_WP, m.
-        probe.velocity (3): v_WP, m/s.
-        target_position (3): x_d, m.
-        references (13): ForceReferenceSystem's "references" (F_ref, F_min,
-            target force, contact; layout in :mod:`vic_drake.systems.signals`).
-        tank_energy (1): T before this tick, J (EnergyTankSystem's
-            "tank_energy"; in MakeVariableImpedanceController the same
-            number, element TANK_ENERGY of its "tank" record, through a
-            C++ Demultiplexer).
+    Input port:
+        inputs (23): one vector (layout: ``QP_INPUTS_SIZE`` and the
+            ``QP_IN_*`` parts of :mod:`vic_drake.systems.signals`):
+            x_d (3, m); the "reference_tick" (19), the head of
+            ForceReferenceSystem's "tick" output: its "references" (F_ref,
+            F_min, target force, contact), then the probe position p_WP (m)
+            and velocity v_WP (m/s) that tick read (the ``REF_*`` slices);
+            and T before this tick (1, J; EnergyTankSystem's
+            "tank_energy", in MakeVariableImpedanceController element
+            TANK_ENERGY of its "tank" record). The controller Diagram builds
+            it with a C++ Multiplexer ("qp_inputs").
 
     Output ports (the last tick, from state):
         stiffness (3): K, N/m.
@@ -99,22 +106,7 @@ class StiffnessQpSystem(LeafSystem):
             if self._constant is not None
             else StiffnessQp(qp.solver, osqp_eps=qp.osqp_eps).solve
         )
-        ports = {}
-        for name, size in (
-            ("probe.position", 3),
-            ("probe.velocity", 3),
-            ("target_position", 3),
-            ("references", REFERENCES_SIZE),
-            ("tank_energy", 1),
-        ):
-            ports[name] = self.DeclareVectorInputPort(name, size)
-        (
-            self._in_position,
-            self._in_velocity,
-            self._in_target,
-            self._in_references,
-            self._in_energy,
-        ) = ports.values()
+        self._inputs = self.DeclareVectorInputPort("inputs", QP_INPUTS_SIZE)
         k0 = self._constant if self._constant is not None else self._k_min
         d0 = [2.0 * self._zeta * math.sqrt(k) for k in k0]
         status0 = np.zeros(len(STATUS_FIELDS))
@@ -152,11 +144,11 @@ class StiffnessQpSystem(LeafSystem):
         # On entry discrete_state holds the current state (a LeafSystem copies
         # it in before calling an update handler): K and the fallback count
         # are read there.
-        p_WP = self._in_position.Eval(context).tolist()
-        v_WP = self._in_velocity.Eval(context).tolist()
-        x_d = self._in_target.Eval(context).tolist()
-        refs = self._in_references.Eval(context).tolist()
-        energy = self._in_energy.Eval(context).tolist()[0]
+        inputs = self._inputs.Eval(context).tolist()
+        x_d = inputs[QP_IN_TARGET]
+        refs = inputs[QP_IN_REFERENCE_TICK]
+        p_WP, v_WP = refs[REF_PROBE_POSITION], refs[REF_PROBE_VELOCITY]
+        energy = inputs[QP_IN_TANK_ENERGY]
         i_k, _, _, i_status = self._state_groups
         k_prev = discrete_state.value(i_k).tolist()
         zeta2 = 2.0 * self._zeta
@@ -166,7 +158,7 @@ class StiffnessQpSystem(LeafSystem):
             zeta2 * math.sqrt(max(k_prev[2], 0.0)),
         )
         # A sum of floats is finite iff every term is (inf - inf = nan).
-        total = sum(p_WP) + sum(v_WP) + sum(x_d) + sum(refs) + energy
+        total = sum(p_WP) + sum(v_WP) + sum(x_d) + sum(refs[:REFERENCES_SIZE]) + energy
         fault = not math.isfinite(total) or refs[REF_FAULT] > 0.5
         e = e_dot = (0.0, 0.0, 0.0)
         ok, solve_time = True, 0.0
@@ -217,6 +209,9 @@ class StiffnessQpSystem(LeafSystem):
         pen = refs[REF_PENETRATION]
         status[_STATUS_PENETRATION] = pen if math.isfinite(pen) else 0.0
         discrete_state.SetFrom(self._scratch)
+
+    def get_inputs_input_port(self):
+        return self._inputs
 
     def get_stiffness_output_port(self):
         return self._out["stiffness"]

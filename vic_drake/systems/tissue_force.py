@@ -46,11 +46,12 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.math import RigidTransform
 from pydrake.multibody.math import SpatialForce, SpatialVelocity
-from pydrake.multibody.plant import ExternallyAppliedSpatialForce
+from pydrake.multibody.plant import ExternallyAppliedSpatialForce, MultibodyPlant
 from pydrake.multibody.tree import BodyIndex
 from pydrake.systems.framework import LeafSystem, ValueProducer
 
 from vic_drake.errors import VicDrakeError
+from vic_drake.systems.body_reader import PlantBodyReader, port_or_error
 from vic_drake.tissue import (
     DEFAULT_UPDATE_PERIOD_S,
     Phantom,
@@ -80,9 +81,14 @@ _SAMPLE_SIZE = len(SAMPLE_FIELDS)
 class TissueForceElement(LeafSystem):
     """Applies the Hunt-Crossley tissue force at the probe tip (see module doc).
 
-    Input ports:
+    Input ports, without ``plant``:
         body_poses: ``list[RigidTransform]`` (the plant's body poses port).
         body_spatial_velocities: ``list[SpatialVelocity]`` (the plant's port).
+    Input port, with ``plant``:
+        plant_state: (n_q + n_v) the plant's state port [q; v]; the element
+            computes the two bodies' poses and velocities from it in a
+            private context of ``plant`` (the same numbers as the list ports;
+            the plant's default parameters, see ``__init__``).
     Output ports:
         spatial_forces: ``list[ExternallyAppliedSpatialForce]`` -- +F on the
             indenter at the tip, -F on the phantom body; connect to the
@@ -138,6 +144,7 @@ class TissueForceElement(LeafSystem):
         along_normal: bool = False,
         relaxation: RelaxationParams | None = None,
         update_period_s: float = DEFAULT_UPDATE_PERIOD_S,
+        plant: MultibodyPlant | None = None,
     ):
         """
         Args:
@@ -156,6 +163,12 @@ class TissueForceElement(LeafSystem):
                 then the instantaneous modulus); None: plain Hunt-Crossley.
             update_period_s: period of the state's update (the plant's
                 step), s.
+            plant: the finalized MultibodyPlant the body indices belong to:
+                the element then reads the plant's state (input
+                "plant_state") instead of the body pose and velocity lists.
+                Its private context has the plant's default parameters: a
+                diagram context whose plant parameters move frames (joint
+                offsets) must use the list ports (no plant).
         """
         if not (np.isfinite(update_period_s) and update_period_s > 0):
             raise VicDrakeError(f"update_period_s must be > 0, got {update_period_s!r}")
@@ -190,12 +203,23 @@ class TissueForceElement(LeafSystem):
             int(phantom_body_index),
         )
         self._p_BT = np.asarray(p_BT, float).reshape(3).tolist()
-        self._poses_port = self.DeclareAbstractInputPort(
-            "body_poses", AbstractValue.Make([RigidTransform()])
-        )
-        self._velocities_port = self.DeclareAbstractInputPort(
-            "body_spatial_velocities", AbstractValue.Make([SpatialVelocity()])
-        )
+        self._poses_port = self._velocities_port = self._state_port = None
+        if plant is None:
+            self._poses_port = self.DeclareAbstractInputPort(
+                "body_poses", AbstractValue.Make([RigidTransform()])
+            )
+            self._velocities_port = self.DeclareAbstractInputPort(
+                "body_spatial_velocities", AbstractValue.Make([SpatialVelocity()])
+            )
+            self._kinematics = self._kinematics_from_lists
+        else:
+            self._reader = PlantBodyReader(
+                plant, (indenter_body_index, phantom_body_index)
+            )
+            self._state_port = self.DeclareVectorInputPort(
+                "plant_state", self._reader.num_states
+            )
+            self._kinematics = self._kinematics_from_plant
         # Relaxation: the branch states (m^beta), updated exactly for the
         # penetration held over each tick.
         self._branches = None
@@ -266,10 +290,15 @@ class TissueForceElement(LeafSystem):
         self._sample_port = self.DeclareStateOutputPort("tissue.sample", self._sample)
 
     def get_body_poses_input_port(self):
-        return self._poses_port
+        return port_or_error(self._poses_port, "body_poses", "a plant")
 
     def get_body_spatial_velocities_input_port(self):
-        return self._velocities_port
+        return port_or_error(
+            self._velocities_port, "body_spatial_velocities", "a plant"
+        )
+
+    def get_plant_state_input_port(self):
+        return port_or_error(self._state_port, "plant_state", "no plant")
 
     def get_spatial_forces_output_port(self):
         return self._forces_port
@@ -293,7 +322,7 @@ class TissueForceElement(LeafSystem):
         return self._sample_port
 
     def tip_position(self, context) -> np.ndarray:
-        """p_WT, m, from the body poses input."""
+        """p_WT, m, from the inputs."""
         return self._contact_cache.Eval(context)[0].copy()
 
     def contact(self, context) -> TipContact:
@@ -316,13 +345,31 @@ class TissueForceElement(LeafSystem):
         """sum_i g_i s_i of branch states ``s``, m^beta."""
         return sum(g * s_i for g, s_i in zip(self._g, s, strict=True))
 
+    def _kinematics_from_lists(self, context):
+        """X_WB (3 x 4 rows), V_WB ([w; v]), p_WPh, v_WPh as lists of floats."""
+        poses = self._poses_port.Eval(context)
+        velocities = self._velocities_port.Eval(context)
+        return (
+            poses[self._i_indenter].GetAsMatrix34().tolist(),
+            velocities[self._i_indenter].get_coeffs().tolist(),
+            poses[self._i_phantom].translation().tolist(),
+            velocities[self._i_phantom].get_coeffs()[3:].tolist(),
+        )
+
+    def _kinematics_from_plant(self, context):
+        """As :meth:`_kinematics_from_lists`, from the plant's state input."""
+        (X, V), (X_Ph, V_Ph) = self._reader(self._state_port.Eval(context))
+        return (
+            X.GetAsMatrix34().tolist(),
+            V.get_coeffs().tolist(),
+            X_Ph.translation().tolist(),
+            V_Ph.get_coeffs()[3:].tolist(),
+        )
+
     def _calc_contact(self, context, value):
         # Cached: p_WT, v_WT (arrays), f_W, the contact terms, the map sample,
         # then p_WT, v_WT, p_WPh, v_WPh as lists of floats.
-        poses = self._poses_port.Eval(context)
-        velocities = self._velocities_port.Eval(context)
-        X = poses[self._i_indenter].GetAsMatrix34().tolist()
-        V = velocities[self._i_indenter].get_coeffs().tolist()  # [w; v]
+        X, V, p_WPh, v_WPh = self._kinematics(context)
         bx, by, bz = self._p_BT
         # p_BT expressed in W (R p_BT), in Eigen's order of the product.
         r = [row[0] * bx + row[1] * by + row[2] * bz for row in X]
@@ -333,8 +380,6 @@ class TissueForceElement(LeafSystem):
             V[4] + (w[2] * r[0] - w[0] * r[2]),
             V[5] + (w[0] * r[1] - w[1] * r[0]),
         ]
-        p_WPh = poses[self._i_phantom].translation().tolist()
-        v_WPh = velocities[self._i_phantom].get_coeffs()[3:].tolist()
         sample = self._phantom(p_WT[0] - p_WPh[0], p_WT[1] - p_WPh[1])
         terms = contact_terms(
             sample, self._beta, p_WT, v_WT, p_WPh, v_WPh, *self._settings,
