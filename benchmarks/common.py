@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import importlib.metadata
+import importlib.util
 import os
 import platform
 import subprocess
@@ -29,9 +30,26 @@ def is_checkout(path) -> bool:
     return path is not None and os.path.isdir(os.path.join(path, "vic_drake"))
 
 
-def run_in_checkout(tree: str, command: list[str]) -> subprocess.CompletedProcess:
-    """Runs ``command`` with the vic_drake of ``tree`` first on the path; exits on failure."""
+def checkout_environment(tree: str) -> dict[str, str]:
+    """The environment ``tree``'s own processes run with: its vic_drake first on
+    the path and, when the checkout has ``vic_drake/malloc_tuning.py``, its
+    ``GLIBC_TUNABLES`` (what its ``vic-drake`` and campaign workers set), so a
+    checkout is measured as it runs."""
     env = dict(os.environ, PYTHONPATH=os.path.abspath(tree))
+    path = os.path.join(tree, "vic_drake", "malloc_tuning.py")
+    if not os.path.isfile(path):
+        return env
+    # Loaded from the file: the module is plain Python (os, sys) and each
+    # checkout has its own.
+    spec = importlib.util.spec_from_file_location("_checkout_malloc_tuning", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.tuned_environment(env) if module.uses_glibc() else env
+
+
+def run_in_checkout(tree: str, command: list[str]) -> subprocess.CompletedProcess:
+    """Runs ``command`` in ``tree``'s environment (:func:`checkout_environment`); exits on failure."""
+    env = checkout_environment(tree)
     done = subprocess.run(command, env=env, capture_output=True, text=True)
     if done.returncode != 0:
         sys.exit(f"the run with {tree} failed:\n{done.stderr[-2000:]}")
