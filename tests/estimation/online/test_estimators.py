@@ -23,7 +23,9 @@ from vic_drake.estimation.online.core import (
     AUX_SIZE,
     CLIP_START,
     N_CLIPPED,
+    N_RESTORED,
     T_UPDATE,
+    confirm_reset,
     initial_state,
     record_clip,
 )
@@ -150,7 +152,7 @@ def test_ekf_layout_and_beta_state():
         method="ekf", estimate_beta=True, surface_walk_m_per_sqrt_s=1e-3
     )
     assert ekf_layout(p) == (4, 2, 3)
-    assert len(ekf_initial_state(p)) == AUX_SIZE + 4 + 16
+    assert len(ekf_initial_state(p)) == AUX_SIZE + 2 * (4 + 16)
     t, z, v, f, s = hc_palpation(4000.0, 30000.0, beta=1.35, seed=7)
     trace = run_online(t, z, v, f, s, p)
     assert np.all(np.isfinite(trace.values[:, :5]))
@@ -205,3 +207,120 @@ def test_a_clipped_run_is_timed_within_contact():
     aux[T_UPDATE] += 0.002
     assert not record_clip(aux, False, aux[T_UPDATE] + 0.002, 0.05, 0.02)
     assert math.isnan(aux[CLIP_START])
+
+
+def _lift_off(kappa, lam, beta, *, hold_s=1.0, eps0=0.008, speed=0.045, seed=0):
+    """A hold at eps0, then the probe lifts at ``speed`` (m/s) until the
+    penetration is gone: (t, z, z_dot, force, s), force >= 0."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(0.0, hold_s + eps0 / speed + 0.05, 0.002)
+    lifting = t > hold_s
+    eps = np.where(lifting, eps0 - speed * (t - hold_s), eps0)
+    eps_dot = np.where(lifting, -speed, 0.0)
+    e = np.clip(eps, 0.0, None)
+    force = np.clip((kappa + lam * eps_dot) * e**beta, 0.0, None)
+    force += rng.normal(0.0, 0.05, t.size)
+    s = 0.1
+    return t, s - eps, -eps_dot, force, s
+
+
+def test_a_lift_off_with_a_wandered_lam_leaves_kappa_where_it_was():
+    # On a scan lam is not excited and wanders (tracking5: 17x the map's);
+    # at the lift-off the estimate then predicts a pull, every update is
+    # clipped, and a covariance reset handed the residual to kappa (held out
+    # of contact at 6.9x the map's on tracking5).
+    p = OnlineEstimatorParams(method="rls")
+    kappa = 3300.0
+    t, z, v, f, s = _lift_off(kappa, p.lam_prior, p.beta)
+    state = rls_initial_state(p)
+    # Converged on kappa (small P), lam_hat at 15 lam_prior.
+    state[AUX_SIZE : AUX_SIZE + 2] = [kappa / p.kappa_prior, 15.0]
+    state[AUX_SIZE + 2] = state[AUX_SIZE + 5] = 1e-6
+    before = after = None
+    for row in zip(t.tolist(), z.tolist(), v.tolist(), f.tolist(), strict=True):
+        state, after = rls_step(state, *row, s, p)
+        if row[0] <= 1.0:
+            before = after.kappa_hat
+    assert after.in_contact == 0.0
+    assert after.kappa_hat == pytest.approx(before, rel=0.05)
+    # ... though the lift-off was clipped throughout, well beyond 50 ms.
+    n_lift = np.count_nonzero((t > 1.0) & (f > p.contact_threshold_N))
+    assert state[N_CLIPPED] >= n_lift > 0.05 / 0.002
+
+
+def test_clipped_updates_that_predict_a_pull_are_no_evidence():
+    aux = initial_state([1.0, 1.0], [0.25, 0.25])[:AUX_SIZE]
+    resets = []
+    for k in range(60):  # 120 ms clipped, every 10th update predicting a pull
+        aux[T_UPDATE] = 0.002 * k
+        evidence = k % 10 != 9
+        resets.append(record_clip(aux, True, 0.002 * (k + 1), 0.05, 0.02, evidence))
+    assert not any(resets)  # the runs last 18 ms at most
+    assert aux[N_CLIPPED] == 60  # yet every clipped update is counted
+
+
+def _surface_follows_the_probe(kappa, beta, *, hold_s=1.0, eps0=0.008, speed=0.045):
+    """A hold at eps0, then the probe lifts at ``speed`` and the phantom
+    follows it (the force stays) while the surface input stays put: the
+    input's penetration shrinks to zero with the force unchanged."""
+    rng = np.random.default_rng(2)
+    t = np.arange(0.0, hold_s + eps0 / speed + 0.05, 0.002)
+    lifting = t > hold_s
+    eps = np.where(lifting, eps0 - speed * (t - hold_s), eps0)
+    force = kappa * eps0**beta + rng.normal(0.0, 0.05, t.size)
+    return t, 0.1 - eps, np.where(lifting, speed, 0.0), force, 0.1
+
+
+@pytest.mark.parametrize("method", METHODS)
+@pytest.mark.parametrize("confirm_s", [0.0, 0.1])
+def test_a_reset_the_contact_does_not_confirm_is_undone(method, confirm_s):
+    p = OnlineEstimatorParams(method=method, reset_confirm_s=confirm_s)
+    t, z, v, f, s = _surface_follows_the_probe(3300.0, p.beta)
+    trace = run_online(t, z, v, f, s, p)
+    state = trace.final_state
+    assert state[N_RESTORED] == (1.0 if confirm_s > 0.0 else 0.0)
+    before = trace.kappa[np.searchsorted(t, 1.0)]
+    assert not trace.in_contact[-1]
+    # The estimate held after the contact: where it was before the clipped
+    # run (the unclipped start of the lift-off moved the EKF's by 11 %), or
+    # (resets always standing) several times the tissue's.
+    if confirm_s > 0.0:
+        assert trace.kappa[-1] == pytest.approx(before, rel=0.15)
+    else:
+        assert trace.kappa[-1] > 2.0 * before
+
+
+def test_confirm_reset_undoes_the_runs_of_an_unconfirmed_reset():
+    x, P = [1.0, 2.0], [1e-4, 0.0, 0.0, 1e-4]
+    aux = initial_state(x, [1e-4, 1e-4])[:AUX_SIZE]
+    saved = [0.0] * 6
+    resets = []
+
+    def update(ms, clipped, x_after):  # an update at ms milliseconds
+        t = ms / 1000.0
+        before = x + P
+        reset = record_clip(aux, clipped, t, 0.05, 0.02)
+        x[0] = x_after
+        confirm_reset(aux, x, P, saved, t, before, reset, 0.1)
+        if reset:
+            P[0] = 0.25
+            resets.append(ms)
+        aux[T_UPDATE] = t
+
+    update(998, False, 1.0)
+    update(1000, True, 1.1)  # a clipped run starts: x of before it is kept
+    assert saved == [1.0, 2.0, 1e-4, 0.0, 0.0, 1e-4]
+    for ms in range(1002, 1120, 2):  # clipped on: a reset every 50 ms or so
+        update(ms, True, 1.1 + (ms - 1000) / 100.0)
+    assert len(resets) == 2 and resets[1] - resets[0] < 100
+    confirm_reset(aux, x, P, saved, 1.122, None, False, 0.1)  # contact ends
+    assert x == [1.0, 2.0] and P[0] == 1e-4  # before the first run
+    assert aux[N_RESTORED] == 1.0
+    # A reset the contact outlasts by 0.1 s stands.
+    for ms in range(2000, 2054, 2):
+        update(ms, True, 1.5)
+    assert len(resets) == 3
+    for ms in range(2054, 2160, 2):
+        update(ms, False, 3.0)
+    confirm_reset(aux, x, P, saved, 2.2, None, False, 0.1)
+    assert x[0] == 3.0 and aux[N_RESTORED] == 1.0

@@ -4,7 +4,9 @@ bookkeeping of one sample, and the scalar Kalman update.
 The estimator state is one flat list of floats (it lives in a LeafSystem's
 discrete state as is): :data:`AUX_SIZE` bookkeeping entries, then the
 parameter vector x (n, normalised: kappa / kappa_prior, lam / lam_prior,
-the surface offset in mm, beta), then its covariance P (n * n, row-major).
+the surface offset in mm, beta), then its covariance P (n * n, row-major),
+then a saved copy of x and P (n + n * n: what they were before a covariance
+reset that contact has not yet confirmed, :func:`confirm_reset`).
 
 Per sample (:func:`prepare`):
 
@@ -20,7 +22,11 @@ Per sample (:func:`prepare`):
   ``min_penetration_m``; only samples in contact update x;
 - innovations are clipped at ``gate_sigma`` (spikes); when every update
   has been clipped for ``clip_reset_s``, P returns to the prior
-  (:func:`record_clip`).
+  (:func:`record_clip`; updates whose estimate predicts a pulling force
+  do not count). Contact must then go on for ``reset_confirm_s``: a contact
+  that ends sooner was the run of clipped updates (a lift-off, a surface
+  that moved away), and x and P return to what they were before the reset
+  (:func:`confirm_reset`).
 
 All arithmetic is on Python floats: the filters are 2 to 4 states, where
 numpy's per-call overhead would dominate a tick.
@@ -44,7 +50,9 @@ N_FAULTS = 6  # non-finite or out-of-order samples
 N_CLIPPED = 7  # updates whose innovation was clipped (spikes, big changes)
 T_UPDATE = 8  # time of the last update, s (NaN before the first)
 CLIP_START = 9  # time of the first of the clipped updates in a row, s (NaN: none)
-AUX_SIZE = 10
+RESET_T = 10  # time of the last covariance reset not yet confirmed, s (NaN: none)
+N_RESTORED = 11  # unconfirmed resets undone at the end of their contact
+AUX_SIZE = 12
 
 #: Fields of the estimator's outputs, in order (:class:`Estimate`).
 OUTPUT_FIELDS = (
@@ -93,16 +101,24 @@ def initial_state(x0: list[float], p0_diag: list[float]) -> list[float]:
     """A fresh state: no sample seen, x = x0, P = diag(p0_diag)."""
     n = len(x0)
     aux = [math.nan, math.nan, math.nan, 0.0, 0.0, 0.0, 0.0, 0.0, math.nan, math.nan]
+    aux += [math.nan, 0.0]
     P = [0.0] * (n * n)
     for i in range(n):
         P[i * n + i] = float(p0_diag[i])
-    return aux + [float(v) for v in x0] + P
+    x = [float(v) for v in x0]
+    return aux + x + P + x + P
 
 
-def unpack(state, n: int) -> tuple[list[float], list[float], list[float]]:
-    """(aux, x, P) as new lists."""
+def state_size(n: int) -> int:
+    """Length of the state of an n-parameter filter."""
+    return AUX_SIZE + 2 * (n + n * n)
+
+
+def unpack(state, n: int) -> tuple[list[float], list[float], list[float], list[float]]:
+    """(aux, x, P, saved x and P) as new lists."""
     state = list(state)
-    return state[:AUX_SIZE], state[AUX_SIZE : AUX_SIZE + n], state[AUX_SIZE + n :]
+    a, b = AUX_SIZE + n, AUX_SIZE + n + n * n
+    return state[:AUX_SIZE], state[AUX_SIZE:a], state[a:b], state[b:]
 
 
 def prepare(
@@ -187,7 +203,12 @@ def scalar_update(
 
 
 def record_clip(
-    aux: list[float], clipped: bool, t: float, reset_s: float, max_gap_s: float
+    aux: list[float],
+    clipped: bool,
+    t: float,
+    reset_s: float,
+    max_gap_s: float,
+    evidence: bool = True,
 ) -> bool:
     """Counts a clipped update (in ``aux``); True when P must return to the prior.
 
@@ -198,17 +219,71 @@ def record_clip(
     covariance, not with a spike: the caller then resets the covariance to
     the prior (:func:`reset_covariance`; the estimate is kept), so that the
     data move the estimate again. ``reset_s`` 0: never.
+
+    ``evidence`` False: the clipped update is counted but ends the run and
+    cannot start one. The callers pass False when the estimate predicts a
+    pulling force at the sample's penetration rate (kappa + lam eps_dot
+    <= 0): the model holds only where it pushes, so the residual says that
+    the estimate (lam at that rate) is outside it, not that the tissue
+    changed, and a reset would hand the residual to kappa.
     """
     if not clipped:
         aux[CLIP_START] = math.nan
         return False
     aux[N_CLIPPED] += 1.0
+    if not evidence:
+        aux[CLIP_START] = math.nan
+        return False
     if math.isnan(aux[CLIP_START]) or not t - aux[T_UPDATE] <= max_gap_s:
         aux[CLIP_START] = t
     if reset_s > 0.0 and t - aux[CLIP_START] >= reset_s:
         aux[CLIP_START] = math.nan
         return True
     return False
+
+
+def confirm_reset(
+    aux: list[float],
+    x: list[float],
+    P: list[float],
+    saved: list[float],
+    t: float,
+    update: list[float] | None,
+    reset: bool,
+    confirm_s: float,
+) -> None:
+    """Keeps or undoes a covariance reset; x, P, saved and aux in place.
+
+    Call on every good sample: after the update and :func:`record_clip`
+    with ``update`` the x + P of before the update (``reset``: record_clip
+    asked for a reset; P is reset after this call), or with ``update`` None
+    on a sample out of contact. ``saved`` keeps x + P of before the first
+    update of the current run of clipped updates. A reset is confirmed once
+    the updates have gone on for ``confirm_s`` after it. Before that, the
+    first sample out of contact puts back the saved x and P, of before the
+    run that led to the first of the unconfirmed resets: that run was the
+    contact's ending (a lift-off, a surface that moved with the probe),
+    which says nothing of the tissue, and the estimate is held out of
+    contact for the next one. ``confirm_s`` 0: resets are never undone.
+    """
+    n = len(x)
+    pending = not math.isnan(aux[RESET_T])
+    if update is None:
+        if pending:
+            x[:] = saved[:n]
+            P[:] = saved[n:]
+            aux[RESET_T] = math.nan
+            aux[N_RESTORED] += 1.0
+        return
+    if pending and t - aux[RESET_T] >= confirm_s:
+        aux[RESET_T] = math.nan
+        pending = False
+        if not math.isnan(aux[CLIP_START]):  # in a run: its evidence from here
+            saved[:] = update
+    elif not pending and aux[CLIP_START] == t:  # a run starts
+        saved[:] = update
+    if reset and confirm_s > 0.0:
+        aux[RESET_T] = t
 
 
 def reset_covariance(P: list[float], prior_var: list[float]) -> None:
@@ -270,11 +345,13 @@ __all__ = [
     "Sample",
     "bound_parameters",
     "cap_variances",
+    "confirm_reset",
     "initial_state",
     "make_estimate",
     "prepare",
     "record_clip",
     "reset_covariance",
     "scalar_update",
+    "state_size",
     "unpack",
 ]

@@ -18,7 +18,9 @@ of the time since the last update (a contact loss of a few seconds lets
 the estimate move again at re-contact), capped at the prior variance.
 Faulty samples and samples out of contact change nothing. Clipped
 innovations and the covariance reset after ``clip_reset_s`` of them in a
-row: as the RLS (:func:`~vic_drake.estimation.online.core.record_clip`).
+row (those predicting a pulling force not counting), undone if the contact
+ends before ``reset_confirm_s``: as the RLS
+(:func:`~vic_drake.estimation.online.core.record_clip`).
 
 With ``surface_from_slope`` (:func:`ekf_slope_step`) a fit of the tissue's
 local slope under the moving tip (:mod:`vic_drake.estimation.online.slope`)
@@ -32,19 +34,20 @@ from __future__ import annotations
 import math
 
 from vic_drake.estimation.online.core import (
-    AUX_SIZE,
     IN_CONTACT,
     N_UPDATES,
     S_PREV,
     T_UPDATE,
     Estimate,
     bound_parameters,
+    confirm_reset,
     initial_state,
     make_estimate,
     prepare,
     record_clip,
     reset_covariance,
     scalar_update,
+    state_size,
     unpack,
 )
 from vic_drake.estimation.online.params import OnlineEstimatorParams
@@ -110,13 +113,14 @@ def ekf_step(
     """
     p = params
     n, i_s, i_b = ekf_layout(p)
-    aux, x, P = unpack(state, n)
+    aux, x, P, saved = unpack(state, n)
     beta = x[i_b] if i_b is not None else p.beta
     sample = prepare(aux, t, z, z_dot, force, surface_z, x[0] * p.kappa_prior, beta, p)
     ds = x[i_s] * _MM if i_s is not None else 0.0
     if sample is None:
         aux[IN_CONTACT] = 0.0
-        return aux + x + P, make_estimate(aux, x, P, p, aux[S_PREV] + ds, False)
+        est = make_estimate(aux, x, P, p, aux[S_PREV] + ds, False)
+        return aux + x + P + saved, est
     surface = sample.s + ds
     eps = surface - z
     contact = sample.contact and eps > p.min_penetration_m
@@ -136,20 +140,27 @@ def ekf_step(
             h[i_s] = stiff * beta * eps ** (beta - 1.0) * _MM
         if i_b is not None:
             h[i_b] = predicted * math.log(eps)
+        before = x + P
         clipped = scalar_update(
             x, P, h, force - predicted, p.noise_std_N**2, p.gate_sigma
         )
-        if record_clip(aux, clipped, t, p.clip_reset_s, p.max_gap_s):
-            reset_covariance(P, _prior(p)[1])
+        reset = record_clip(aux, clipped, t, p.clip_reset_s, p.max_gap_s, stiff > 0.0)
         bound_parameters(x, p.max_rel_change)
+        confirm_reset(aux, x, P, saved, t, before, reset, p.reset_confirm_s)
+        if reset:
+            reset_covariance(P, _prior(p)[1])
         if i_b is not None:
             x[i_b] = min(max(x[i_b], 0.5), 3.0)
         if i_s is not None:
             surface = sample.s + x[i_s] * _MM
         aux[N_UPDATES] += 1.0
         aux[T_UPDATE] = t
+    else:
+        confirm_reset(aux, x, P, saved, t, None, False, p.reset_confirm_s)
+        if i_s is not None:
+            surface = sample.s + x[i_s] * _MM
     aux[IN_CONTACT] = 1.0 if contact else 0.0
-    return aux + x + P, make_estimate(aux, x, P, p, surface, contact)
+    return aux + x + P + saved, make_estimate(aux, x, P, p, surface, contact)
 
 
 def ekf_slope_initial_state(params: OnlineEstimatorParams) -> list[float]:
@@ -170,7 +181,7 @@ def ekf_slope_step(
     (arguments and result as :func:`ekf_step`)."""
     p = params
     n, _, _ = ekf_layout(p)
-    size = AUX_SIZE + n + n * n
+    size = state_size(n)
     state = list(state)
     ekf_state = state[:size]
     fit, slope = slope_step(

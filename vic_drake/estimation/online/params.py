@@ -69,7 +69,12 @@ class OnlineEstimatorParams:
         clip_reset_s: when every update has been clipped for this long, s,
             the covariance returns to the prior (the tissue changed faster
             than the covariance allowed, or the prior was far off); 0:
-            never.
+            never. Clipped updates where the estimate predicts a pulling
+            force (kappa + lam eps_dot <= 0) do not count.
+        reset_confirm_s: a covariance reset stands once the contact has
+            gone on for this long after it, s; a contact that ends sooner
+            puts back the estimate and covariance of before the reset (the
+            clipped run was the contact's ending); 0: resets always stand.
         valid_rel_std: the estimate is flagged valid in contact once the
             std of kappa is below this fraction of kappa_hat.
         max_gap_s: a sample more than this after the previous one restarts
@@ -111,6 +116,7 @@ class OnlineEstimatorParams:
     min_penetration_m: float = 0.5e-3
     gate_sigma: float = 4.0
     clip_reset_s: float = 0.05
+    reset_confirm_s: float = 0.1
     valid_rel_std: float = 0.1
     max_gap_s: float = 0.02
     surface_rate_time_constant_s: float = 0.02
@@ -146,6 +152,7 @@ class OnlineEstimatorParams:
             "min_penetration_m",
             "surface_rate_time_constant_s",
             "clip_reset_s",
+            "reset_confirm_s",
         ):
             _number(name, getattr(self, name), low=0.0)
         _number("gate_sigma", self.gate_sigma, low=0.0, low_open=True)

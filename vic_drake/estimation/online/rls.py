@@ -13,7 +13,10 @@ divided by it before each update. A direction the data does not excite
 contact, and on a faulty sample, nothing is forgotten and nothing learnt:
 the estimate is held. Innovations beyond ``gate_sigma`` are clipped (spikes);
 after ``clip_reset_s`` of clipped updates in a row the covariance returns to
-the prior (:func:`~vic_drake.estimation.online.core.record_clip`). Shared
+the prior (:func:`~vic_drake.estimation.online.core.record_clip`), updates
+where the estimate predicts a pulling force (kappa + lam eps_dot <= 0, out of
+the model's domain) not counting; a reset that contact does not confirm
+(``reset_confirm_s``) is undone when the contact ends. Shared
 bookkeeping (faults, surface, contact) in
 :mod:`vic_drake.estimation.online.core`.
 
@@ -34,6 +37,7 @@ from vic_drake.estimation.online.core import (
     Estimate,
     bound_parameters,
     cap_variances,
+    confirm_reset,
     initial_state,
     make_estimate,
     prepare,
@@ -77,14 +81,14 @@ def rls_step(
     Returns:
         (new state, Estimate).
     """
-    aux, x, P = unpack(state, RLS_SIZE)
+    aux, x, P, saved = unpack(state, RLS_SIZE)
     p = params
     sample = prepare(
         aux, t, z, z_dot, force, surface_z, x[0] * p.kappa_prior, p.beta, p
     )
     if sample is None:
         aux[IN_CONTACT] = 0.0
-        return aux + x + P, make_estimate(aux, x, P, p, aux[S_PREV], False)
+        return aux + x + P + saved, make_estimate(aux, x, P, p, aux[S_PREV], False)
     eps = sample.s - z
     contact = sample.contact and eps > p.min_penetration_m
     if contact:
@@ -97,14 +101,21 @@ def rls_step(
             cap = p.prior_rel_std**2
             cap_variances(P, [cap, cap])
         innovation = force - (h[0] * x[0] + h[1] * x[1])
+        # Stiffness of the estimate at this rate (<= 0: it predicts a pull).
+        stiff = p.kappa_prior * x[0] + p.lam_prior * x[1] * eps_dot
+        before = x + P
         clipped = scalar_update(x, P, h, innovation, p.noise_std_N**2, p.gate_sigma)
-        if record_clip(aux, clipped, t, p.clip_reset_s, p.max_gap_s):
-            reset_covariance(P, [p.prior_rel_std**2] * RLS_SIZE)
+        reset = record_clip(aux, clipped, t, p.clip_reset_s, p.max_gap_s, stiff > 0.0)
         bound_parameters(x, p.max_rel_change)
+        confirm_reset(aux, x, P, saved, t, before, reset, p.reset_confirm_s)
+        if reset:
+            reset_covariance(P, [p.prior_rel_std**2] * RLS_SIZE)
         aux[N_UPDATES] += 1.0
         aux[T_UPDATE] = t
+    else:
+        confirm_reset(aux, x, P, saved, t, None, False, p.reset_confirm_s)
     aux[IN_CONTACT] = 1.0 if contact else 0.0
-    return aux + x + P, make_estimate(aux, x, P, p, sample.s, contact)
+    return aux + x + P + saved, make_estimate(aux, x, P, p, sample.s, contact)
 
 
 __all__ = ["RLS_SIZE", "rls_initial_state", "rls_step"]
