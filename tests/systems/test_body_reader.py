@@ -32,6 +32,29 @@ def free_and_lifted_plant():
     return plant, context
 
 
+def contexts_fed_both_ways(plant, plant_context, lists, state):
+    """Contexts of a system built without (``lists``) and with (``state``)
+    ``plant=``, their body inputs fixed from ``plant_context``: the list ports
+    it has, or the plant's state. First checks that each refuses the other's
+    port."""
+    with pytest.raises(VicDrakeError, match="no 'body_poses' input port"):
+        state.get_body_poses_input_port()
+    with pytest.raises(VicDrakeError, match="no 'plant_state' input port"):
+        lists.get_plant_state_input_port()
+    c_lists, c_state = lists.CreateDefaultContext(), state.CreateDefaultContext()
+    lists.get_body_poses_input_port().FixValue(
+        c_lists, plant.get_body_poses_output_port().Eval(plant_context)
+    )
+    if lists.HasInputPort("body_spatial_velocities"):
+        lists.GetInputPort("body_spatial_velocities").FixValue(
+            c_lists, plant.get_body_spatial_velocities_output_port().Eval(plant_context)
+        )
+    state.get_plant_state_input_port().FixValue(
+        c_state, plant.get_state_output_port().Eval(plant_context)
+    )
+    return c_lists, c_state
+
+
 def test_reads_the_same_poses_and_velocities_as_the_plants_list_ports():
     plant, context = free_and_lifted_plant()
     poses = plant.get_body_poses_output_port().Eval(context)

@@ -124,7 +124,10 @@ def test_one_sample_equals_the_pure_tare_in_any_orientation():
 def test_plant_state_input_gives_the_body_poses_numbers():
     """Built with the plant, the sensor reads its body's orientation from the
     plant's state vector: the same readings as from the body poses list."""
-    from tests.systems.test_body_reader import free_and_lifted_plant
+    from tests.systems.test_body_reader import (
+        contexts_fed_both_ways,
+        free_and_lifted_plant,
+    )
 
     plant, plant_context = free_and_lifted_plant()
     kw = dict(
@@ -133,17 +136,7 @@ def test_plant_state_input_gives_the_body_poses_numbers():
         p_SScm=[0.003, 0.01, 0.02], lag_samples=1, bias=[0, 0, 0, 0.1, -0.2, 0.3],
     )  # fmt: skip
     lists, state = ForceTorqueSensor(**kw), ForceTorqueSensor(plant=plant, **kw)
-    with pytest.raises(VicDrakeError, match="no 'body_poses' input port"):
-        state.get_body_poses_input_port()
-    with pytest.raises(VicDrakeError, match="no 'plant_state' input port"):
-        lists.get_plant_state_input_port()
-    c_lists, c_state = lists.CreateDefaultContext(), state.CreateDefaultContext()
-    lists.get_body_poses_input_port().FixValue(
-        c_lists, plant.get_body_poses_output_port().Eval(plant_context)
-    )
-    state.get_plant_state_input_port().FixValue(
-        c_state, plant.get_state_output_port().Eval(plant_context)
-    )
+    c_lists, c_state = contexts_fed_both_ways(plant, plant_context, lists, state)
     for k in range(3):
         reaction = [SpatialForce([0.01 * k, -0.02, 0.03], [1.0, -2.0 * k, 3.0])]
         for system, context in ((state, c_state), (lists, c_lists)):

@@ -301,8 +301,10 @@ def test_the_stored_sample_is_the_contact_the_next_plant_step_uses():
 def test_plant_state_input_gives_the_list_ports_numbers():
     """Built with the plant, the element reads its state vector: every output
     is bit-identical to the element fed the plant's pose and velocity lists."""
-    from tests.systems.test_body_reader import free_and_lifted_plant
-    from vic_drake.errors import VicDrakeError
+    from tests.systems.test_body_reader import (
+        contexts_fed_both_ways,
+        free_and_lifted_plant,
+    )
     from vic_drake.tissue import RelaxationParams
 
     plant, plant_context = free_and_lifted_plant()
@@ -314,20 +316,7 @@ def test_plant_state_input_gives_the_list_ports_numbers():
     )  # fmt: skip
     lists = TissueForceElement(_plane_phantom(), **kw)
     state = TissueForceElement(_plane_phantom(), plant=plant, **kw)
-    with pytest.raises(VicDrakeError, match="no 'body_poses' input port"):
-        state.get_body_poses_input_port()
-    with pytest.raises(VicDrakeError, match="no 'plant_state' input port"):
-        lists.get_plant_state_input_port()
-    c_lists, c_state = lists.CreateDefaultContext(), state.CreateDefaultContext()
-    lists.get_body_poses_input_port().FixValue(
-        c_lists, plant.get_body_poses_output_port().Eval(plant_context)
-    )
-    lists.get_body_spatial_velocities_input_port().FixValue(
-        c_lists, plant.get_body_spatial_velocities_output_port().Eval(plant_context)
-    )
-    state.get_plant_state_input_port().FixValue(
-        c_state, plant.get_state_output_port().Eval(plant_context)
-    )
+    c_lists, c_state = contexts_fed_both_ways(plant, plant_context, lists, state)
     assert state.get_penetration_output_port().Eval(c_state)[0] > 0  # In contact.
     for _ in range(3):  # Ticks move the relaxation branches.
         for port in ("tissue.force_W", "tissue.penetration", "tissue.surface_z",

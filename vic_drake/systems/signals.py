@@ -52,10 +52,10 @@ TICK_RECORD_SIZE = len(TICK_RECORD_FIELDS)
 
 #: ForceReferenceSystem's "measurement" input: what a tick reads, the first
 #: nine :data:`TICK_RECORD_FIELDS` (p_WP, m; v_WP, m/s; F/T force in W, N).
-MEASUREMENT_SIZE = 9
 MEASURED_POSITION = slice(0, 3)
 MEASURED_VELOCITY = slice(3, 6)
 MEASURED_FORCE = slice(6, 9)
+MEASUREMENT_SIZE = MEASURED_FORCE.stop
 
 #: The "references" port: F_ref (3, N), F_min (3, N), the FDCC target force
 #: (3, N), then the :data:`CONTACT_FIELDS`.

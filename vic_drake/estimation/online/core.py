@@ -100,8 +100,8 @@ class Sample(NamedTuple):
 def initial_state(x0: list[float], p0_diag: list[float]) -> list[float]:
     """A fresh state: no sample seen, x = x0, P = diag(p0_diag)."""
     n = len(x0)
-    aux = [math.nan, math.nan, math.nan, 0.0, 0.0, 0.0, 0.0, 0.0, math.nan, math.nan]
-    aux += [math.nan, 0.0]
+    aux = [math.nan, math.nan, math.nan, 0.0, 0.0, 0.0, 0.0, 0.0, math.nan]
+    aux += [math.nan, math.nan, 0.0]  # CLIP_START, RESET_T, N_RESTORED
     P = [0.0] * (n * n)
     for i in range(n):
         P[i * n + i] = float(p0_diag[i])
@@ -286,6 +286,30 @@ def confirm_reset(
         aux[RESET_T] = t
 
 
+def gated_update(
+    aux: list[float],
+    x: list[float],
+    P: list[float],
+    saved: list[float],
+    t: float,
+    h: list[float],
+    innovation: float,
+    stiffness: float,
+    p: OnlineEstimatorParams,
+) -> bool:
+    """One update in contact, in place: :func:`scalar_update` with the gate,
+    :func:`record_clip` (``stiffness`` = kappa + lam eps_dot of the estimate
+    before the update; <= 0 is no evidence), :func:`bound_parameters` and
+    :func:`confirm_reset`. True when the caller must reset P to its prior
+    (:func:`reset_covariance`)."""
+    before = x + P
+    clipped = scalar_update(x, P, h, innovation, p.noise_std_N**2, p.gate_sigma)
+    reset = record_clip(aux, clipped, t, p.clip_reset_s, p.max_gap_s, stiffness > 0.0)
+    bound_parameters(x, p.max_rel_change)
+    confirm_reset(aux, x, P, saved, t, before, reset, p.reset_confirm_s)
+    return reset
+
+
 def reset_covariance(P: list[float], prior_var: list[float]) -> None:
     """P = diag(prior_var), in place."""
     n = len(prior_var)
@@ -346,6 +370,7 @@ __all__ = [
     "bound_parameters",
     "cap_variances",
     "confirm_reset",
+    "gated_update",
     "initial_state",
     "make_estimate",
     "prepare",

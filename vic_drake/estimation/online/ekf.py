@@ -39,14 +39,12 @@ from vic_drake.estimation.online.core import (
     S_PREV,
     T_UPDATE,
     Estimate,
-    bound_parameters,
     confirm_reset,
+    gated_update,
     initial_state,
     make_estimate,
     prepare,
-    record_clip,
     reset_covariance,
-    scalar_update,
     state_size,
     unpack,
 )
@@ -140,14 +138,7 @@ def ekf_step(
             h[i_s] = stiff * beta * eps ** (beta - 1.0) * _MM
         if i_b is not None:
             h[i_b] = predicted * math.log(eps)
-        before = x + P
-        clipped = scalar_update(
-            x, P, h, force - predicted, p.noise_std_N**2, p.gate_sigma
-        )
-        reset = record_clip(aux, clipped, t, p.clip_reset_s, p.max_gap_s, stiff > 0.0)
-        bound_parameters(x, p.max_rel_change)
-        confirm_reset(aux, x, P, saved, t, before, reset, p.reset_confirm_s)
-        if reset:
+        if gated_update(aux, x, P, saved, t, h, force - predicted, stiff, p):
             reset_covariance(P, _prior(p)[1])
         if i_b is not None:
             x[i_b] = min(max(x[i_b], 0.5), 3.0)

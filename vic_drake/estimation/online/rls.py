@@ -35,15 +35,13 @@ from vic_drake.estimation.online.core import (
     S_PREV,
     T_UPDATE,
     Estimate,
-    bound_parameters,
     cap_variances,
     confirm_reset,
+    gated_update,
     initial_state,
     make_estimate,
     prepare,
-    record_clip,
     reset_covariance,
-    scalar_update,
     unpack,
 )
 from vic_drake.estimation.online.params import OnlineEstimatorParams
@@ -103,12 +101,7 @@ def rls_step(
         innovation = force - (h[0] * x[0] + h[1] * x[1])
         # Stiffness of the estimate at this rate (<= 0: it predicts a pull).
         stiff = p.kappa_prior * x[0] + p.lam_prior * x[1] * eps_dot
-        before = x + P
-        clipped = scalar_update(x, P, h, innovation, p.noise_std_N**2, p.gate_sigma)
-        reset = record_clip(aux, clipped, t, p.clip_reset_s, p.max_gap_s, stiff > 0.0)
-        bound_parameters(x, p.max_rel_change)
-        confirm_reset(aux, x, P, saved, t, before, reset, p.reset_confirm_s)
-        if reset:
+        if gated_update(aux, x, P, saved, t, h, innovation, stiff, p):
             reset_covariance(P, [p.prior_rel_std**2] * RLS_SIZE)
         aux[N_UPDATES] += 1.0
         aux[T_UPDATE] = t
