@@ -33,6 +33,15 @@ def test_folder_without_metadata(tmp_path):
         read_bag(tmp_path)
 
 
+def test_file_outside_a_bag_is_named(tmp_path):
+    stray = tmp_path / "notes.txt"
+    stray.write_text("not a bag")
+    with pytest.raises(
+        VicDrakeError, match="no metadata.yaml beside the file 'notes.txt'"
+    ):
+        read_bag(stray)
+
+
 def test_corrupt_bag(tmp_path, data_dir):
     bag = tmp_path / "bad"
     shutil.copytree(data_dir / "palpation" / "test_soft_2hz", bag)

@@ -117,10 +117,12 @@ def read_bag_array(path: str | os.PathLike) -> tuple[np.ndarray, str]:
             f"bag {str(path)!r} does not exist; expected a ROS 2 bag folder "
             "(metadata.yaml + .db3)"
         )
+    given = path
     if path.is_file():
         path = path.parent
     if not (path / "metadata.yaml").is_file():
-        raise _bag_error(path, "no metadata.yaml in the folder")
+        where = "in the folder" if given == path else f"beside the file {given.name!r}"
+        raise _bag_error(path, f"no metadata.yaml {where}")
     typestore = get_typestore(Stores.ROS2_HUMBLE)
     try:
         with AnyReader([path], default_typestore=typestore) as reader:

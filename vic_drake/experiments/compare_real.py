@@ -152,9 +152,9 @@ def compare_real(
     bag = Path(bag_dir)
     if not bag.exists():
         raise VicDrakeError(f"bag {str(bag)!r} does not exist; pass a ROS 2 bag folder")
+    raw = read_bag(bag)
     if bag.is_file():
         bag = bag.parent
-    raw = read_bag(bag)
     if raw.attrs["layout"] not in ("controller", "scan"):
         raise VicDrakeError(
             f"bag {str(bag)!r} has the {raw.attrs['layout']!r} layout "
