@@ -129,7 +129,9 @@ class OnlineEstimatorSystem(LeafSystem):
             s = self._surface_lookup(m[_X], m[_Y])[0]
         else:
             s = math.nan
-        state = context.get_discrete_state(self._filter).get_value().tolist()
+        # Drake fills discrete_state with the current state before calling
+        # this handler: the filter state is read from it and written in place.
+        state = discrete_state.value(self._filter).tolist()
         state, est = self._step(
             state,
             context.get_time(),
@@ -139,8 +141,8 @@ class OnlineEstimatorSystem(LeafSystem):
             s,
             self._params,
         )
-        discrete_state.set_value(self._filter, state)
-        discrete_state.set_value(self._estimate, est)
+        discrete_state.get_mutable_value(self._filter)[:] = state
+        discrete_state.get_mutable_value(self._estimate)[:] = est
 
     def get_measurement_input_port(self):
         return self._measurement_port
