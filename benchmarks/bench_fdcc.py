@@ -35,6 +35,7 @@ from pydrake.multibody.tree import JacobianWrtVariable
 from vic_drake.control.fdcc import FdccConstants, FdccParams, fdcc_step, fdcc_tick
 from vic_drake.station import StationParams, initial_q_for_tip
 from vic_drake.systems.fdcc import FdccController
+from vic_drake.systems.signals import FDCC_INPUT_PARTS, FDCC_INPUTS_SIZE
 
 START = np.array([-0.06, -0.36, 0.13])
 
@@ -44,14 +45,16 @@ def _controller():
     system = FdccController(FdccParams(), station_params=StationParams(), initial_q=q0)
     context = system.CreateDefaultContext()
     inputs = {
-        system.get_joint_positions_input_port(): q0 + 0.001,
-        system.get_target_position_input_port(): START + [0.0, 0.0, 0.01],
-        system.get_stiffness_input_port(): np.array([300.0, 300.0, 300.0]),
-        system.get_measured_force_input_port(): np.array([0.0, 0.0, -1.0]),
-        system.get_target_force_input_port(): np.array([0.0, 0.0, -2.0]),
+        "joint_positions": q0 + 0.001,
+        "target_position": START + [0.0, 0.0, 0.01],
+        "stiffness": np.array([300.0, 300.0, 300.0]),
+        "ft_sensor.force_W": np.array([0.0, 0.0, -1.0]),
+        "target_force": np.array([0.0, 0.0, -2.0]),
     }
-    for port, value in inputs.items():
-        port.FixValue(context, value)
+    u = np.zeros(FDCC_INPUTS_SIZE)
+    for name, part in FDCC_INPUT_PARTS:
+        u[part] = inputs[name]
+    system.get_inputs_input_port().FixValue(context, u)
     return system, context, q0, list(inputs.values())
 
 

@@ -9,7 +9,10 @@ DIR`` (another checkout) when given. Needs valgrind (Debian's package);
 each run takes a few minutes.
 
     python benchmarks/bench_scan_instructions.py [--baseline DIR] [--from 3.2] [--to 3.4]
-        [--controller vs-vf]
+        [--controller vs-vf] [--online]
+
+``--online``: the scan with the online tissue estimator (online_compare's
+"online" run of that controller's scenario).
 """
 
 from __future__ import annotations
@@ -26,7 +29,7 @@ import tempfile
 from common import HERE, is_checkout, run_in_checkout, versions
 
 
-def _worker(controller: str, t0: float, t1: float) -> None:
+def _worker(controller: str, t0: float, t1: float, online: bool) -> None:
     """The scan, with callgrind's instrumentation on from t0 to t1 only."""
     from pydrake.common import RandomGenerator
     from pydrake.systems.analysis import Simulator
@@ -39,6 +42,10 @@ def _worker(controller: str, t0: float, t1: float) -> None:
     )
 
     scenario = synthetic_scenario(controller)
+    if online:
+        from vic_drake.experiments.online_compare import comparison_scenario
+
+        scenario = comparison_scenario(scenario, "online")
     diagram, _ = MakeScanDiagram(scenario)
     simulator = Simulator(diagram)
     context = simulator.get_mutable_context()
@@ -62,6 +69,7 @@ def _count(tree: str, args) -> float:
         command += [f"--callgrind-out-file={out}", sys.executable]
         command += [os.path.abspath(__file__), "--worker", args.controller]
         command += ["--from", str(args.t0), "--to", str(args.t1)]
+        command += ["--online"] if args.online else []
         done = run_in_checkout(tree, command)
         ticks = re.search(r"^ticks (\d+)", done.stdout, re.M)
         dumps = [p for p in glob.glob(out + ".*") if not p.endswith(out)]
@@ -78,19 +86,25 @@ def main() -> int:
     parser.add_argument("--controller", default="vs-vf")
     parser.add_argument("--from", dest="t0", type=float, default=3.2)
     parser.add_argument("--to", dest="t1", type=float, default=3.4)
+    parser.add_argument(
+        "--online", action="store_true", help="with the online tissue estimator"
+    )
     parser.add_argument("--worker", metavar="CONTROLLER", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if not 0 <= args.t0 < args.t1:
         parser.error(f"need 0 <= --from < --to; got {args.t0}, {args.t1}")
     if args.worker:
-        _worker(args.worker, args.t0, args.t1)
+        _worker(args.worker, args.t0, args.t1, args.online)
         return 0
     if shutil.which("valgrind") is None:
         parser.error("valgrind is not installed (Debian: apt-get install valgrind)")
     if args.baseline is not None and not is_checkout(args.baseline):
         parser.error(f"--baseline must be a checkout of vic_drake; got {args.baseline}")
     print(versions())
-    print(f"{args.controller} scan, ticks from {args.t0} s to {args.t1} s (in contact)")
+    online = " (online estimator)" if args.online else ""
+    print(
+        f"{args.controller}{online} scan, ticks from {args.t0} s to {args.t1} s (in contact)"
+    )
     trees = {"current": HERE}
     if args.baseline is not None:
         trees = {"baseline": args.baseline, **trees}

@@ -34,7 +34,7 @@ from pydrake.systems.primitives import ConstantVectorSource, Demultiplexer
 
 from vic_drake.control.fdcc import FdccParams
 from vic_drake.station import MakeStation, StationParams, initial_q_for_tip
-from vic_drake.systems.fdcc import FdccController
+from vic_drake.systems.fdcc import AddFdccInputs, FdccController
 from vic_drake.tissue import load_phantom
 
 XY = (-0.06, -0.36)
@@ -62,18 +62,19 @@ def _with_fdcc(params, phantom, *, stiffness, target_dz, target_force):
     )
     demux = builder.AddSystem(Demultiplexer([6, 6]))
     builder.Connect(station.GetOutputPort("ur3e.state"), demux.get_input_port())
-    builder.Connect(demux.get_output_port(0), fdcc.get_joint_positions_input_port())
+    inputs = AddFdccInputs(builder, fdcc)
+    builder.Connect(demux.get_output_port(0), inputs["joint_positions"])
     builder.Connect(
-        station.GetOutputPort("ft_sensor.force_W"), fdcc.get_measured_force_input_port()
+        station.GetOutputPort("ft_sensor.force_W"), inputs["ft_sensor.force_W"]
     )
     builder.Connect(
         fdcc.get_position_command_output_port(),
         station.GetInputPort("ur3e.position_command"),
     )
     for port, value in (
-        (fdcc.get_target_position_input_port(), [*XY, s + target_dz]),
-        (fdcc.get_stiffness_input_port(), stiffness),
-        (fdcc.get_target_force_input_port(), target_force),
+        (inputs["target_position"], [*XY, s + target_dz]),
+        (inputs["stiffness"], stiffness),
+        (inputs["target_force"], target_force),
         (station.GetInputPort("phantom.lift"), [0.0]),
     ):
         source = builder.AddSystem(ConstantVectorSource(np.asarray(value, float)))

@@ -1,8 +1,9 @@
 """Do the scans of this checkout log exactly what another checkout's logged?
 
 A speed change must not change behaviour. This runs the same scans (VS-VF
-and VS-CF nominal, CS, CF and VS-VF with the phantom lifted; the synthetic
-phantom, seeded noise) with the code of ``--baseline DIR`` (another
+and VS-CF nominal, CS, CF and VS-VF with the phantom lifted, and VS-VF
+nominal with the online tissue estimator, online_compare's "online" run;
+the synthetic phantom, seeded noise) with the code of ``--baseline DIR`` (another
 checkout, e.g. ``git worktree add DIR <commit>``) and with this checkout,
 each in a fresh process, and prints for each scan the largest absolute
 difference of every logged column that differs. "worst 0" means
@@ -21,24 +22,32 @@ import tempfile
 import pandas as pd
 from common import HERE, is_checkout, run_in_checkout, versions
 
-#: (controller, disturbed) of the compared scans.
+#: (controller, disturbed, online_compare run or None) of the compared scans.
 CASES = (
-    ("vs-vf", False),
-    ("vs-cf", False),
-    ("cs", True),
-    ("cf", True),
-    ("vs-vf", True),
+    ("vs-vf", False, None),
+    ("vs-cf", False, None),
+    ("cs", True, None),
+    ("cf", True, None),
+    ("vs-vf", True, None),
+    ("vs-vf", False, "online"),
 )
+
+
+def _file(controller: str, disturbed: bool, run) -> str:
+    return f"{controller}_{int(disturbed)}{'' if run is None else '_' + run}.parquet"
 
 
 def _worker(out_dir: str, duration_s: float) -> None:
     """Runs the cases with the vic_drake on sys.path; one parquet each."""
     from vic_drake.experiments import run_scan, synthetic_scenario
+    from vic_drake.experiments.online_compare import comparison_scenario
 
-    for controller, disturbed in CASES:
+    for controller, disturbed, run in CASES:
         scenario = synthetic_scenario(controller, disturbed=disturbed)
+        if run is not None:
+            scenario = comparison_scenario(scenario, run)
         df = run_scan(scenario, duration_s=duration_s).df.select_dtypes("number")
-        df.to_parquet(os.path.join(out_dir, f"{controller}_{int(disturbed)}.parquet"))
+        df.to_parquet(os.path.join(out_dir, _file(controller, disturbed, run)))
 
 
 def _run(tree: str, out_dir: str, duration_s: float) -> None:
@@ -65,8 +74,8 @@ def main() -> int:
     with tempfile.TemporaryDirectory() as old, tempfile.TemporaryDirectory() as new:
         _run(args.baseline, old, args.duration)
         _run(HERE, new, args.duration)
-        for controller, disturbed in CASES:
-            name = f"{controller}_{int(disturbed)}.parquet"
+        for controller, disturbed, run in CASES:
+            name = _file(controller, disturbed, run)
             a = pd.read_parquet(os.path.join(old, name))
             b = pd.read_parquet(os.path.join(new, name))
             if list(a.columns) != list(b.columns) or a.shape != b.shape:
@@ -78,6 +87,7 @@ def main() -> int:
             worst = max(worst, float(diff.max()))
             print(
                 f"{controller:6s} {'disturbed' if disturbed else 'nominal  '} "
+                f"{'' if run is None else run + ' '}"
                 f"{len(a)} rows: "
                 + (
                     "identical"

@@ -8,7 +8,16 @@ from pydrake.systems.primitives import ConstantVectorSource, Demultiplexer
 
 from vic_drake.control.fdcc import FdccParams, fdcc_step
 from vic_drake.station import MakeStation, StationParams, initial_q_for_tip
-from vic_drake.systems.fdcc import FdccController
+from vic_drake.systems.fdcc import AddFdccInputs, FdccController
+from vic_drake.systems.signals import (
+    FDCC_IN_FORCE,
+    FDCC_IN_JOINT_POSITIONS,
+    FDCC_IN_STIFFNESS,
+    FDCC_IN_TARGET_FORCE,
+    FDCC_IN_TARGET_POSITION,
+    FDCC_INPUT_PARTS,
+    FDCC_INPUTS_SIZE,
+)
 from vic_drake.tissue import SyntheticChestPhantom
 
 #: Above a nearly level point of the synthetic chest (surface slope < 0.04).
@@ -20,26 +29,31 @@ def q_start():
     return initial_q_for_tip(START)
 
 
-def _fix_inputs(system, context, q, *, stiffness=(300.0, 300.0, 300.0)):
-    system.get_joint_positions_input_port().FixValue(context, q)
-    system.get_target_position_input_port().FixValue(context, START + [0, 0, 0.01])
-    system.get_stiffness_input_port().FixValue(context, np.asarray(stiffness))
-    system.get_measured_force_input_port().FixValue(context, [0.0, 0.0, -1.0])
-    system.get_target_force_input_port().FixValue(context, [0.0, 0.0, -2.0])
+def _fix_inputs(
+    system, context, q, *, stiffness=(300.0, 300.0, 300.0), force=(0.0, 0.0, -1.0)
+):
+    u = np.zeros(FDCC_INPUTS_SIZE)
+    u[FDCC_IN_JOINT_POSITIONS] = q
+    u[FDCC_IN_TARGET_POSITION] = START + [0, 0, 0.01]
+    u[FDCC_IN_STIFFNESS] = stiffness
+    u[FDCC_IN_FORCE] = force
+    u[FDCC_IN_TARGET_FORCE] = [0.0, 0.0, -2.0]
+    system.get_inputs_input_port().FixValue(context, u)
+
+
+def test_input_parts_tile_the_inputs_vector():
+    parts = [part for _, part in FDCC_INPUT_PARTS]
+    assert [p.start for p in parts] == [0, *(p.stop for p in parts[:-1])]
+    assert [p.stop - p.start for p in parts] == [6, 3, 3, 3, 3]
+    assert parts[-1].stop == FDCC_INPUTS_SIZE == 18
 
 
 def test_ports_and_one_tick_equals_the_pure_step(q_start):
     system = FdccController(
         FdccParams(), station_params=StationParams(), initial_q=q_start
     )
-    for name, size in [
-        ("joint_positions", 6),
-        ("target_position", 3),
-        ("stiffness", 3),
-        ("ft_sensor.force_W", 3),
-        ("target_force", 3),
-    ]:
-        assert system.GetInputPort(name).size() == size
+    assert system.num_input_ports() == 1
+    assert system.GetInputPort("inputs").size() == FDCC_INPUTS_SIZE
     assert system.GetOutputPort("position_command").size() == 6
     context = system.CreateDefaultContext()
     np.testing.assert_array_equal(
@@ -90,7 +104,7 @@ def test_nan_input_holds_the_command_and_flags(q_start):
     context.SetDiscreteState(system.EvalUniquePeriodicDiscreteUpdate(context))
     context.SetDiscreteState(system.EvalUniquePeriodicDiscreteUpdate(context))
     held = system.get_position_command_output_port().Eval(context).copy()
-    system.get_measured_force_input_port().FixValue(context, [0.0, np.nan, 0.0])
+    _fix_inputs(system, context, q_start, force=(0.0, np.nan, 0.0))
     for _ in range(3):
         context.SetDiscreteState(system.EvalUniquePeriodicDiscreteUpdate(context))
     np.testing.assert_array_equal(
@@ -100,7 +114,7 @@ def test_nan_input_holds_the_command_and_flags(q_start):
         system.get_status_output_port().Eval(context), [1.0, 3.0]
     )
     # Recovery: a finite input clears the flag, the count stays.
-    system.get_measured_force_input_port().FixValue(context, [0.0, 0.0, -1.0])
+    _fix_inputs(system, context, q_start)
     context.SetDiscreteState(system.EvalUniquePeriodicDiscreteUpdate(context))
     np.testing.assert_array_equal(
         system.get_status_output_port().Eval(context), [0.0, 3.0]
@@ -137,18 +151,19 @@ def _closed_loop(q0, station_params, *, target, stiffness, target_force):
     )
     demux = builder.AddSystem(Demultiplexer([6, 6]))
     builder.Connect(station.GetOutputPort("ur3e.state"), demux.get_input_port())
-    builder.Connect(demux.get_output_port(0), fdcc.get_joint_positions_input_port())
+    inputs = AddFdccInputs(builder, fdcc)
+    builder.Connect(demux.get_output_port(0), inputs["joint_positions"])
     builder.Connect(
-        station.GetOutputPort("ft_sensor.force_W"), fdcc.get_measured_force_input_port()
+        station.GetOutputPort("ft_sensor.force_W"), inputs["ft_sensor.force_W"]
     )
     builder.Connect(
         fdcc.get_position_command_output_port(),
         station.GetInputPort("ur3e.position_command"),
     )
     for port, value in (
-        (fdcc.get_target_position_input_port(), target),
-        (fdcc.get_stiffness_input_port(), stiffness),
-        (fdcc.get_target_force_input_port(), target_force),
+        (inputs["target_position"], target),
+        (inputs["stiffness"], stiffness),
+        (inputs["target_force"], target_force),
         (station.GetInputPort("phantom.lift"), [0.0]),
     ):
         source = builder.AddSystem(ConstantVectorSource(np.asarray(value, float)))

@@ -81,6 +81,32 @@ def test_noise_scales_the_noise_input():
     )
 
 
+def test_unconnected_noise_input_reads_noise_free():
+    """A noisy sensor without a noise input reads what a noise-free one does;
+    with the input it reads the same plus the scaled noise."""
+    noisy = _sensor(noise_std=[0, 0, 0, 0.1, 0.2, 0.3], bias=[0, 0, 0, 0.5, 0, 0])
+    plain = _sensor(bias=[0, 0, 0, 0.5, 0, 0])
+    readings = []
+    for system, noise in ((noisy, None), (plain, None), (noisy, np.ones(6))):
+        context = system.CreateDefaultContext()
+        _fix(system, context, np.array([1.0, -2.0, 3.0]))
+        if noise is not None:
+            system.get_noise_input_port().FixValue(context, noise)
+        context.SetDiscreteState(system.EvalUniquePeriodicDiscreteUpdate(context))
+        readings.append(system.get_wrench_output_port().Eval(context).copy())
+    np.testing.assert_array_equal(readings[0], [0, 0, 0, 1.5, -2.0, 3.0])
+    np.testing.assert_array_equal(readings[0], readings[1])
+    np.testing.assert_allclose(readings[2], [0, 0, 0, 1.6, -1.8, 3.3])
+
+
+def test_without_lag_no_sample_buffer_is_kept():
+    """The state is the reading alone without a lag, plus the samples with one."""
+    assert _sensor().CreateDefaultContext().num_discrete_state_groups() == 2
+    context = _sensor(lag_samples=2).CreateDefaultContext()
+    assert context.num_discrete_state_groups() == 3
+    assert context.get_discrete_state(0).size() == 18
+
+
 def test_bad_settings_are_rejected():
     with pytest.raises(VicDrakeError, match="lag_samples"):
         _sensor(lag_samples=-1)

@@ -19,13 +19,25 @@ from vic_drake.systems.online_estimator import (
     OnlineEstimatorSystem,
     RlsEstimatorSystem,
 )
+from vic_drake.systems.signals import (
+    MEASURED_FORCE,
+    MEASURED_POSITION,
+    MEASURED_VELOCITY,
+    MEASUREMENT_SIZE,
+)
+
+
+def _measurement(z, v, f, xy=(0.0, 0.0)):
+    m = np.zeros(MEASUREMENT_SIZE)
+    m[MEASURED_POSITION] = [*xy, z]
+    m[MEASURED_VELOCITY] = [0.0, 0.0, v]
+    m[MEASURED_FORCE] = [0.0, 0.0, -f]
+    return m
 
 
 def _tick(system, context, t, z, v, f, s):
     context.SetTime(t)
-    system.GetInputPort("probe.position").FixValue(context, [0.0, 0.0, z])
-    system.GetInputPort("probe.velocity").FixValue(context, [0.0, 0.0, v])
-    system.GetInputPort("ft_sensor.force_W").FixValue(context, [0.0, 0.0, -f])
+    system.get_measurement_input_port().FixValue(context, _measurement(z, v, f))
     system.GetInputPort("surface_z").FixValue(context, [s])
     state = system.EvalUniquePeriodicDiscreteUpdate(context)
     context.SetDiscreteState(state)
@@ -68,7 +80,8 @@ def test_recovers_parameters_and_survives_nan(kind):
 def test_without_surface_input_the_prior_is_published_before_contact():
     p = OnlineEstimatorParams(method="ekf")
     system = OnlineEstimatorSystem(p, period_s=0.002, surface_input=False)
-    assert system.num_input_ports() == 3
+    assert system.num_input_ports() == 1
+    assert system.get_measurement_input_port().size() == MEASUREMENT_SIZE
     context = system.CreateDefaultContext()
     est = system.get_estimate_output_port().Eval(context)
     assert est[0] == p.kappa_prior and est[1] == p.lam_prior
@@ -80,3 +93,27 @@ def test_bad_arguments():
         OnlineEstimatorSystem({"method": "rls"}, period_s=0.002)
     with pytest.raises(VicDrakeError, match="period_s"):
         OnlineEstimatorSystem(OnlineEstimatorParams(), period_s=0.0)
+
+
+def test_map_surface_is_read_at_the_measured_x_y():
+    """With a surface map, the tick's surface is the map's under the probe's
+    (x, y) from the measurement vector, not under any other point."""
+    from vic_drake.tissue.phantom import GridPhantom
+
+    xs, ys = np.array([0.0, 0.01]), np.array([0.0, 0.02])
+    heights = np.array([[0.10, 0.11], [0.12, 0.14]])  # Rows: x; columns: y.
+    grid = np.full((2, 2), 5000.0)
+    tissue = GridPhantom(x_m=xs, y_m=ys, z_m=heights, kappa=grid, lam=grid)
+    system = RlsEstimatorSystem(
+        OnlineEstimatorParams(), period_s=0.002, surface_input=False, surface_map=tissue
+    )
+    context = system.CreateDefaultContext()
+    x, y = 0.004, 0.015
+    system.get_measurement_input_port().FixValue(
+        context, _measurement(0.105, -0.01, 5.0, xy=(x, y))
+    )
+    context.SetDiscreteState(system.EvalUniquePeriodicDiscreteUpdate(context))
+    got = system.get_surface_output_port().Eval(context)[0]
+    lookup = tissue.point_lookup()
+    assert got == lookup(x, y)[0]
+    assert got not in (lookup(y, x)[0], lookup(0.0, 0.0)[0], lookup(x, 0.0)[0])

@@ -10,7 +10,7 @@ Signal flow (all vectors in the base frame W)::
     target ──► controller ◄── probe.position / probe.velocity / ft_sensor.force_W
                  │ stiffness, target_force
                  ▼
-    target ──► fdcc ◄── ur3e.state (q), ft_sensor.force_W
+    target ──► fdcc ◄── ur3e.state (q), ft_sensor.force_W  (one vector: "fdcc_inputs")
                  │ position_command
                  ▼
     lift ────► station
@@ -43,7 +43,7 @@ from vic_drake.station import (
     set_station_state,
 )
 from vic_drake.systems.controller import MakeVariableImpedanceController
-from vic_drake.systems.fdcc import FdccController
+from vic_drake.systems.fdcc import AddFdccInputs, FdccController
 from vic_drake.systems.trajectory import PhantomLiftSource, TargetTrajectorySource
 from vic_drake.tissue.phantom import GridPhantom, load_phantom
 
@@ -232,17 +232,17 @@ def MakeScanDiagram(
         controller.GetInputPort("target_position"),
     )
     builder.Connect(station.GetOutputPort("ur3e.state"), demux.get_input_port())
-    builder.Connect(demux.get_output_port(0), fdcc.GetInputPort("joint_positions"))
-    builder.Connect(
-        target.get_target_position_output_port(), fdcc.GetInputPort("target_position")
-    )
-    builder.Connect(
-        controller.GetOutputPort("stiffness"), fdcc.GetInputPort("stiffness")
-    )
-    builder.Connect(force, fdcc.get_measured_force_input_port())
-    builder.Connect(
-        controller.GetOutputPort("target_force"), fdcc.GetInputPort("target_force")
-    )
+    # The FDCC reads its five inputs as one vector, built by a C++
+    # Multiplexer: one port evaluation per tick instead of five.
+    fdcc_inputs = AddFdccInputs(builder, fdcc)
+    for source, part in (
+        (demux.get_output_port(0), "joint_positions"),
+        (target.get_target_position_output_port(), "target_position"),
+        (controller.GetOutputPort("stiffness"), "stiffness"),
+        (force, "ft_sensor.force_W"),
+        (controller.GetOutputPort("target_force"), "target_force"),
+    ):
+        builder.Connect(source, fdcc_inputs[part])
     builder.Connect(
         fdcc.GetOutputPort("position_command"),
         station.GetInputPort("ur3e.position_command"),

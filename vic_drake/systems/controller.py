@@ -15,8 +15,8 @@ and the probe position and velocity they were computed from (the head of
 record) through two C++ Demultiplexers, "reference_fields" and
 "tank_fields", so that neither read calls Python. The reference system and
 the QP each read their inputs as one vector built by a C++ Multiplexer
-("measurement": the three measured inputs; "qp_inputs": x_d, the reference
-tick's head, T). All four controllers (CS, CF, VS-CF, VS-VF) expose the
+("measurement": the three measured inputs, which the online estimator
+reads too; "qp_inputs": x_d, the reference tick's head, T). All four controllers (CS, CF, VS-CF, VS-VF) expose the
 same ports; see
 :class:`vic_drake.control.params.ReferenceParams` for how each maps to
 (stiffness, target_force) of the compliance (FDCC) stage.
@@ -153,10 +153,12 @@ def MakeVariableImpedanceController(
         "measurement", Multiplexer([part.stop - part.start for part in parts.values()])
     )
     builder.Connect(measurement.get_output_port(0), ref.get_measurement_input_port())
+    if online:  # The estimator reads the same vector.
+        builder.Connect(
+            measurement.get_output_port(0), est.get_measurement_input_port()
+        )
     for i, name in enumerate(parts):
-        index = builder.ExportInput(measurement.get_input_port(i), name)
-        if online:
-            builder.ConnectInput(index, est.GetInputPort(name))
+        builder.ExportInput(measurement.get_input_port(i), name)
     # The QP reads x_d, its reference tick and T as one vector, built by a C++
     # Multiplexer: one port evaluation per tick instead of three.
     qp_inputs = builder.AddNamedSystem(

@@ -5,23 +5,37 @@ A thin adapter around :func:`vic_drake.control.fdcc.fdcc_tick` (the tick of
 reads its inputs, runs one FDCC tick and stores the joint position command,
 the internal joint velocity and the PD's last error in its discrete state.
 The CS, CF and variable-stiffness controllers all drive it through
-``stiffness`` and ``target_force``.
+the stiffness and target force parts of its one "inputs" vector, which
+:func:`AddFdccInputs` builds with a C++ Multiplexer.
 """
 
 from __future__ import annotations
 
 import numpy as np
 from pydrake.systems.framework import LeafSystem
+from pydrake.systems.primitives import Multiplexer
 
 from vic_drake.control.fdcc import FdccConstants, FdccModel, FdccParams, fdcc_tick
 from vic_drake.errors import VicDrakeError
 from vic_drake.models.ur3e import MakeFdccModel
+from vic_drake.systems.signals import (
+    FDCC_IN_FORCE,
+    FDCC_IN_JOINT_POSITIONS,
+    FDCC_IN_STIFFNESS,
+    FDCC_IN_TARGET_FORCE,
+    FDCC_IN_TARGET_POSITION,
+    FDCC_INPUT_PARTS,
+    FDCC_INPUTS_SIZE,
+)
 
 
 class FdccController(LeafSystem):
     """Forward dynamics compliance control of the UR3e probe.
 
-    Input ports:
+    Input port:
+        inputs (18, ``signals.FDCC_INPUTS_SIZE``): one vector of five parts
+        (``signals.FDCC_INPUT_PARTS``, the ``FDCC_IN_*`` slices), built in
+        a Diagram by :func:`AddFdccInputs`:
         joint_positions (6): measured joint angles, rad.
         target_position (3): target probe tip position x_d in W, m (the
             orientation target is FdccParams.target_orientation_wxyz, the
@@ -68,11 +82,7 @@ class FdccController(LeafSystem):
             raise VicDrakeError(
                 f"initial_q must be 6 finite joint angles (rad), got {initial_q!r}"
             )
-        self._q_port = self.DeclareVectorInputPort("joint_positions", 6)
-        self._target_port = self.DeclareVectorInputPort("target_position", 3)
-        self._stiffness_port = self.DeclareVectorInputPort("stiffness", 3)
-        self._measured_port = self.DeclareVectorInputPort("ft_sensor.force_W", 3)
-        self._target_force_port = self.DeclareVectorInputPort("target_force", 3)
+        self._inputs_port = self.DeclareVectorInputPort("inputs", FDCC_INPUTS_SIZE)
         self._q_cmd = self.DeclareDiscreteState(q0)
         self._internal = self.DeclareDiscreteState(12)
         self._status = self.DeclareDiscreteState(2)
@@ -94,20 +104,8 @@ class FdccController(LeafSystem):
         """The internal model (e.g. for forward kinematics of the probe)."""
         return self._model
 
-    def get_joint_positions_input_port(self):
-        return self._q_port
-
-    def get_target_position_input_port(self):
-        return self._target_port
-
-    def get_stiffness_input_port(self):
-        return self._stiffness_port
-
-    def get_measured_force_input_port(self):
-        return self._measured_port
-
-    def get_target_force_input_port(self):
-        return self._target_force_port
+    def get_inputs_input_port(self):
+        return self._inputs_port
 
     def get_position_command_output_port(self):
         return self._command_port
@@ -127,17 +125,18 @@ class FdccController(LeafSystem):
         # Drake fills discrete_state with the current state before calling
         # this handler: each group is read and written in place.
         command, internal, status = map(discrete_state.get_mutable_value, self._groups)
+        u = self._inputs_port.Eval(context)
         result = fdcc_tick(
             self._model,
             self._constants,
-            self._q_port.Eval(context),
+            u[FDCC_IN_JOINT_POSITIONS],
             command,
             internal[:6],
             internal[6:],
-            self._target_port.Eval(context),
-            self._stiffness_port.Eval(context),
-            self._measured_port.Eval(context),
-            self._target_force_port.Eval(context),
+            u[FDCC_IN_TARGET_POSITION],
+            u[FDCC_IN_STIFFNESS],
+            u[FDCC_IN_FORCE],
+            u[FDCC_IN_TARGET_FORCE],
         )
         if result is None:  # Hold the command, stop the internal motion.
             internal[:] = 0.0
@@ -149,3 +148,24 @@ class FdccController(LeafSystem):
             internal[:] = qd + err
             status[0] = 0.0
             status[1] = status[1] + 0.0
+
+
+def AddFdccInputs(builder, fdcc: FdccController, *, name: str = "fdcc_inputs"):
+    """Adds the C++ Multiplexer that builds ``fdcc``'s "inputs" vector.
+
+    Args:
+        builder: the DiagramBuilder holding ``fdcc``.
+        fdcc: the FdccController whose "inputs" port the Multiplexer feeds.
+        name: the Multiplexer's name in the Diagram.
+
+    Returns:
+        The Multiplexer's input port of each part, by the part's name in
+        :data:`vic_drake.systems.signals.FDCC_INPUT_PARTS` ("joint_positions",
+        "target_position", "stiffness", "ft_sensor.force_W", "target_force"),
+        for the caller to connect or fix.
+    """
+    mux = builder.AddNamedSystem(
+        name, Multiplexer([part.stop - part.start for _, part in FDCC_INPUT_PARTS])
+    )
+    builder.Connect(mux.get_output_port(0), fdcc.get_inputs_input_port())
+    return {part: mux.get_input_port(i) for i, (part, _) in enumerate(FDCC_INPUT_PARTS)}

@@ -94,8 +94,9 @@ class ForceTorqueSensor(LeafSystem):
         force_W: (3,) the reading's force expressed in W with the orientation
             of S at the last sample, N (negative z = pressing down into the
             body). Zero before the first sample.
-    State (discrete, updated every ``period_s``): the last ``lag_samples +
-    1`` tared samples, and the reading (wrench_S, force_W) they give.
+    State (discrete, updated every ``period_s``): with ``lag_samples > 0``
+    the last ``lag_samples + 1`` tared samples; the reading (wrench_S,
+    force_W) they give.
     """
 
     def __init__(
@@ -166,7 +167,8 @@ class ForceTorqueSensor(LeafSystem):
                 "plant_state", self._reader.num_states
             )
         self._noise_port = self.DeclareVectorInputPort("noise", 6)
-        self._buffer = self.DeclareDiscreteState(6 * self._n)
+        # Without a lag the reading is the newest sample: no buffer.
+        self._buffer = self.DeclareDiscreteState(6 * self._n) if self._n > 1 else None
         self._wrench = self.DeclareDiscreteState(self._bias.copy())
         self._force = self.DeclareDiscreteState(3)
         self.DeclarePeriodicDiscreteUpdateEvent(period_s, 0.0, self._update)
@@ -213,20 +215,31 @@ class ForceTorqueSensor(LeafSystem):
             gravity_W=self._gravity_W,
         )
 
+    def _noise(self, context):
+        """The noise input's samples, or None when the port has no value."""
+        try:  # Connected in a station: one crossing, no HasValue.
+            return self._noise_port.Eval(context)
+        except RuntimeError:
+            if self._noise_port.HasValue(context):
+                raise
+            return None
+
     def _update(self, context, discrete_state):
         R_WC = self._R_WC(context)
         R_WS = R_WC if self._identity_CS else R_WC @ self._R_CS
         F_S = self._reaction_port.Eval(context)[self._joint].get_coeffs()
         # = tared_sensor_wrench(F_S, R_WS, ...), one product per tick.
         sample = F_S - self._static_per_g @ (R_WS.T @ self._gravity_W)
-        if self._noisy and self._noise_port.HasValue(context):
-            sample = sample + self._noise_std * self._noise_port.Eval(context)
-        if self._n > 1:
+        if self._noisy:
+            noise = self._noise(context)
+            if noise is not None:
+                sample = sample + self._noise_std * noise
+        if self._buffer is None:
+            reading = sample + self._bias
+        else:
             old = context.get_discrete_state(self._buffer).get_value()
             buffer = np.concatenate([sample, old[: 6 * (self._n - 1)]])
-        else:
-            buffer = sample
-        discrete_state.set_value(self._buffer, buffer)
-        reading = buffer[6 * (self._n - 1) :] + self._bias
+            discrete_state.set_value(self._buffer, buffer)
+            reading = buffer[6 * (self._n - 1) :] + self._bias
         discrete_state.set_value(self._wrench, reading)
         discrete_state.set_value(self._force, R_WS @ reading[3:])

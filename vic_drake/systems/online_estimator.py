@@ -1,8 +1,9 @@
 """OnlineEstimatorSystem: the RLS or EKF tissue estimator as a LeafSystem.
 
 A thin adapter over :mod:`vic_drake.estimation.online`: every period it
-reads the probe's position and velocity, the F/T force and (optionally) the
-surface height, calls the pure step function of the chosen method and
+reads the probe's position and velocity and the F/T force (one
+"measurement" vector, the reference system's) and (optionally) the surface
+height, calls the pure step function of the chosen method and
 stores the filter state and the estimate in discrete state; the outputs
 publish the estimate from state (the values of the last tick).
 """
@@ -21,6 +22,18 @@ from vic_drake.estimation.online import (
     OnlineEstimatorParams,
     estimator_functions,
 )
+from vic_drake.systems.signals import (
+    MEASURED_FORCE,
+    MEASURED_POSITION,
+    MEASURED_VELOCITY,
+    MEASUREMENT_SIZE,
+)
+
+#: Where the estimator's scalars sit in the "measurement" vector: the probe
+#: tip's x, y, z, its z velocity and the force's z.
+_X, _Y, _Z = range(MEASURED_POSITION.start, MEASURED_POSITION.stop)
+_VZ = MEASURED_VELOCITY.start + 2
+_FZ = MEASURED_FORCE.start + 2
 
 #: Index of each field in the "estimate" output.
 ESTIMATE_SIZE = len(OUTPUT_FIELDS)
@@ -31,10 +44,11 @@ class OnlineEstimatorSystem(LeafSystem):
     """Online kappa, lambda (and surface) estimate from force and motion.
 
     Input ports:
-        probe.position (3): probe tip p_WP, m.
-        probe.velocity (3): v_WP, m/s.
-        ft_sensor.force_W (3): F/T force in W, N, sensor convention
-            (negative z = pressing; the tissue force is minus its z).
+        measurement (9, ``signals.MEASUREMENT_SIZE``): what a tick reads,
+            the layout of ForceReferenceSystem's input (the ``MEASURED_*``
+            slices of :mod:`vic_drake.systems.signals`): probe tip p_WP, m;
+            v_WP, m/s; F/T force in W, N, sensor convention (negative z =
+            pressing; the tissue force is minus its z).
         surface_z (1): tissue surface height under the probe, m (only with
             ``surface_input=True``; NaN = unknown). Without it the surface
             is latched at first contact (and corrected by the EKF when its
@@ -71,9 +85,9 @@ class OnlineEstimatorSystem(LeafSystem):
         _, est0 = self._step(
             state0, 0.0, 0.0, 0.0, math.nan, math.nan, self._params
         )  # A fault sample: the prior's outputs, state unchanged but the count.
-        self._position_port = self.DeclareVectorInputPort("probe.position", 3)
-        self._velocity_port = self.DeclareVectorInputPort("probe.velocity", 3)
-        self._force_port = self.DeclareVectorInputPort("ft_sensor.force_W", 3)
+        self._measurement_port = self.DeclareVectorInputPort(
+            "measurement", MEASUREMENT_SIZE
+        )
         if surface_input and surface_map is not None:
             raise VicDrakeError("give either surface_input or surface_map, not both")
         self._surface_port = (
@@ -108,27 +122,30 @@ class OnlineEstimatorSystem(LeafSystem):
         return calc
 
     def _update(self, context, discrete_state):
-        p = self._position_port.Eval(context)
-        v = self._velocity_port.Eval(context)
-        f = self._force_port.Eval(context)
+        m = self._measurement_port.Eval(context).tolist()
         if self._surface_port is not None:
             s = float(self._surface_port.Eval(context)[0])
-        elif self._surface_lookup is not None and math.isfinite(p[0] + p[1]):
-            s = self._surface_lookup(float(p[0]), float(p[1]))[0]
+        elif self._surface_lookup is not None and math.isfinite(m[_X] + m[_Y]):
+            s = self._surface_lookup(m[_X], m[_Y])[0]
         else:
             s = math.nan
-        state = context.get_discrete_state(self._filter).get_value().tolist()
+        # Drake fills discrete_state with the current state before calling
+        # this handler: the filter state is read from it and written in place.
+        state = discrete_state.value(self._filter).tolist()
         state, est = self._step(
             state,
             context.get_time(),
-            float(p[2]),
-            float(v[2]),
-            -float(f[2]),
+            m[_Z],
+            m[_VZ],
+            -m[_FZ],
             s,
             self._params,
         )
-        discrete_state.set_value(self._filter, state)
-        discrete_state.set_value(self._estimate, est)
+        discrete_state.get_mutable_value(self._filter)[:] = state
+        discrete_state.get_mutable_value(self._estimate)[:] = est
+
+    def get_measurement_input_port(self):
+        return self._measurement_port
 
     def get_estimate_output_port(self):
         return self._ports["estimate"]

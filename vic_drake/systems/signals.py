@@ -17,6 +17,8 @@ one place both their writer and their readers take the layout from:
 - ``qp_tick`` (StiffnessQpSystem -> EnergyTankSystem): what the QP's last
   tick used, which the tank integrates within the same tick. One port keeps
   the tank's step at one port evaluation per tick.
+- ``inputs`` (FdccController): the FDCC tick's five inputs, one vector
+  (one port evaluation per tick: a C++ Multiplexer in the scan Diagram).
 - ``status`` (StiffnessQpSystem) and ``tank`` (EnergyTankSystem): records
   logged as one vector each; :data:`STATUS_FIELDS` and :data:`TANK_FIELDS`
   name their elements in order.
@@ -85,6 +87,25 @@ QP_IN_TARGET = slice(0, 3)
 QP_IN_REFERENCE_TICK = slice(3, 3 + REFERENCE_TICK_SIZE)
 QP_IN_TANK_ENERGY = QP_IN_REFERENCE_TICK.stop
 QP_INPUTS_SIZE = QP_IN_TANK_ENERGY + 1
+
+#: FdccController's one "inputs" vector (a C++ Multiplexer builds it, see
+#: :func:`vic_drake.systems.fdcc.AddFdccInputs`): the measured joint angles
+#: q (6, rad), the target tip position x_d (3, m, W), the stiffness K (3,
+#: N/m), the F/T force in W (3, N, sensor convention) and the target force
+#: (3, N, same convention). :data:`FDCC_INPUT_PARTS` names them in order.
+FDCC_IN_JOINT_POSITIONS = slice(0, 6)
+FDCC_IN_TARGET_POSITION = slice(6, 9)
+FDCC_IN_STIFFNESS = slice(9, 12)
+FDCC_IN_FORCE = slice(12, 15)
+FDCC_IN_TARGET_FORCE = slice(15, 18)
+FDCC_INPUTS_SIZE = FDCC_IN_TARGET_FORCE.stop
+FDCC_INPUT_PARTS = (
+    ("joint_positions", FDCC_IN_JOINT_POSITIONS),
+    ("target_position", FDCC_IN_TARGET_POSITION),
+    ("stiffness", FDCC_IN_STIFFNESS),
+    ("ft_sensor.force_W", FDCC_IN_FORCE),
+    ("target_force", FDCC_IN_TARGET_FORCE),
+)
 
 #: The "qp_tick" port: the QP's last tick as the tank integrates it.
 #: e = x_d - x (3, m), e_dot = -x_dot (3, m/s), K (3, N/m), the damping D
