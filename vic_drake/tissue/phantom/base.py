@@ -10,6 +10,7 @@ each other.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections import OrderedDict
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -20,6 +21,24 @@ from vic_drake.paper import BEST_BETA
 
 if TYPE_CHECKING:
     from vic_drake.tissue.phantom.point_lookup import PointLookup
+
+
+#: Point lookups shared by phantoms with equal :meth:`Phantom.content_key`,
+#: most recently used last; at most :data:`SHARED_LOOKUPS_MAX` are kept.
+_SHARED_LOOKUPS: OrderedDict = OrderedDict()
+SHARED_LOOKUPS_MAX = 2
+
+
+def _shared_point_lookup(key, build) -> PointLookup:
+    """The point lookup of ``key``: the process's shared one, else ``build()``."""
+    lookup = _SHARED_LOOKUPS.get(key)
+    if lookup is None:
+        lookup = _SHARED_LOOKUPS[key] = build()
+        while len(_SHARED_LOOKUPS) > SHARED_LOOKUPS_MAX:
+            _SHARED_LOOKUPS.popitem(last=False)
+    else:
+        _SHARED_LOOKUPS.move_to_end(key)
+    return lookup
 
 
 @dataclass(frozen=True)
@@ -95,8 +114,21 @@ class Phantom(ABC):
         else:
             key = ("raster", float(resolution_m))
         if key not in cache:
-            cache[key] = PointLookup(self, resolution_m=resolution_m)
+            content = self.content_key()
+            if content is None:
+                cache[key] = PointLookup(self, resolution_m=resolution_m)
+            else:
+                cache[key] = _shared_point_lookup(
+                    (content, key),
+                    lambda: PointLookup(self, resolution_m=resolution_m),
+                )
         return cache[key]
+
+    def content_key(self):
+        """A hashable key that is equal for phantoms that answer every query
+        alike (their point lookups are then built once per process and
+        shared), or None: this phantom's lookups are its own."""
+        return None
 
     def rasterize(self, resolution_m: float, bounds=None):
         """Samples the map on a regular grid.

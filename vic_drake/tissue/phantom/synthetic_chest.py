@@ -138,6 +138,19 @@ class SyntheticChestPhantom(Phantom):
         self._tex_dir = rng.uniform(0, np.pi, n)
         self._tex_phase = rng.uniform(0, 2 * np.pi, n)
 
+    def content_key(self):
+        # Everything the phantom answers follows from its parameters (the
+        # texture too, through its seed); the name is copied into a lookup.
+        # A subclass may answer differently: it shares nothing by default.
+        if type(self) is not SyntheticChestPhantom:
+            return None
+        key = ("synthetic chest", self.params, self.name)
+        try:
+            hash(key)
+        except TypeError:  # Parameters holding a list: no sharing.
+            return None
+        return key
+
     @property
     def bounds(self):
         p = self.params
