@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import importlib.metadata
 import importlib.util
 import os
@@ -54,3 +55,22 @@ def run_in_checkout(tree: str, command: list[str]) -> subprocess.CompletedProces
     if done.returncode != 0:
         sys.exit(f"the run with {tree} failed:\n{done.stderr[-2000:]}")
     return done
+
+
+def run_sections(sections: dict, doc: str) -> None:
+    """The command line of a benchmark made of named sections.
+
+    ``--section NAME`` (repeatable; default: all, in order) and
+    ``--data-dir DIR``; each section is called with the resolved data folder.
+    """
+    from vic_drake.paths import resolve_data_dir
+
+    parser = argparse.ArgumentParser(description=doc.split("\n\n")[0])
+    parser.add_argument("--section", choices=tuple(sections), action="append")
+    parser.add_argument("--data-dir", default=None)
+    args = parser.parse_args()
+    data_dir = resolve_data_dir(args.data_dir)
+    print(versions())
+    for name in args.section or sections:
+        print(f"== {name}")
+        sections[name](data_dir)

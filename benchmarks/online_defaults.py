@@ -28,11 +28,10 @@ Sections (``--section``, default all):
 
 from __future__ import annotations
 
-import argparse
 import json
 
 import numpy as np
-from common import versions
+from common import run_sections
 
 from vic_drake.errors import VicDrakeError
 from vic_drake.estimation.online import OnlineEstimatorParams, run_online
@@ -43,7 +42,6 @@ from vic_drake.estimation.palpation import (
     shift,
 )
 from vic_drake.experiments.online_replay import replay_inputs, score_online
-from vic_drake.paths import resolve_data_dir
 from vic_drake.realdata import read_bag
 
 PALPATIONS = {  # log: palpation period, s
@@ -251,17 +249,5 @@ SECTIONS = {
 }
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--section", choices=tuple(SECTIONS), action="append")
-    parser.add_argument("--data-dir", default=None)
-    args = parser.parse_args()
-    data_dir = resolve_data_dir(args.data_dir)
-    print(versions())
-    for name in args.section or SECTIONS:
-        print(f"== {name}")
-        SECTIONS[name](data_dir)
-
-
 if __name__ == "__main__":
-    main()
+    run_sections(SECTIONS, __doc__)

@@ -21,16 +21,13 @@ per log:
 
 from __future__ import annotations
 
-import argparse
-
 import numpy as np
-from common import versions
+from common import run_sections
 
 from vic_drake.estimation.online import OnlineEstimatorParams
 from vic_drake.estimation.online.core import AUX_SIZE, S_DOT
 from vic_drake.estimation.online.replay import estimator_functions, run_online
 from vic_drake.experiments.online_replay import replay_inputs, score_online
-from vic_drake.paths import resolve_data_dir
 
 LOGS = (
     "palpation/test_soft_1hz",
@@ -208,17 +205,5 @@ SECTIONS = {
 }
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--section", choices=tuple(SECTIONS), action="append")
-    parser.add_argument("--data-dir", default=None)
-    args = parser.parse_args()
-    data_dir = resolve_data_dir(args.data_dir)
-    print(versions())
-    for name in args.section or SECTIONS:
-        print(f"== {name}")
-        SECTIONS[name](data_dir)
-
-
 if __name__ == "__main__":
-    main()
+    run_sections(SECTIONS, __doc__)
