@@ -29,7 +29,8 @@ Per sample (:func:`prepare`):
   (:func:`confirm_reset`).
 
 All arithmetic is on Python floats: the filters are 2 to 4 states, where
-numpy's per-call overhead would dominate a tick.
+numpy's per-call overhead would dominate a tick (the update itself:
+:mod:`vic_drake.estimation.online.kalman`).
 """
 
 from __future__ import annotations
@@ -37,6 +38,7 @@ from __future__ import annotations
 import math
 from typing import NamedTuple
 
+from vic_drake.estimation.online.kalman import scalar_update
 from vic_drake.estimation.online.params import OnlineEstimatorParams
 
 # Bookkeeping entries at the head of the state.
@@ -157,49 +159,6 @@ def prepare(
         aux[S_DOT] = 0.0
     aux[S_PREV] = s
     return Sample(dt, s, aux[S_DOT], contact)
-
-
-def scalar_update(
-    x: list[float],
-    P: list[float],
-    h: list[float],
-    innovation: float,
-    r: float,
-    gate_sigma: float,
-) -> bool:
-    """Kalman update with one scalar measurement, in place; True if clipped.
-
-    The innovation is clipped at ``gate_sigma`` predicted standard
-    deviations (Huber-like): a spike moves x by a bounded step.
-    """
-    n = len(x)
-    if n == 2:  # The RLS and the plain EKF: unrolled (a third of the cost).
-        p00, p01, p11 = P[0], P[1], P[3]
-        a = p00 * h[0] + p01 * h[1]
-        b = p01 * h[0] + p11 * h[1]
-        s = h[0] * a + h[1] * b + r
-        bound = gate_sigma * math.sqrt(s)
-        clipped = abs(innovation) > bound
-        if clipped:
-            innovation = math.copysign(bound, innovation)
-        x[0] += a / s * innovation
-        x[1] += b / s * innovation
-        P[0] = p00 - a * a / s
-        P[1] = P[2] = p01 - a * b / s
-        P[3] = p11 - b * b / s
-        return clipped
-    Ph = [sum(P[i * n + j] * h[j] for j in range(n)) for i in range(n)]
-    s = sum(h[i] * Ph[i] for i in range(n)) + r
-    bound = gate_sigma * math.sqrt(s)
-    clipped = abs(innovation) > bound
-    if clipped:
-        innovation = math.copysign(bound, innovation)
-    for i in range(n):
-        x[i] += Ph[i] / s * innovation
-    for i in range(n):
-        for j in range(n):
-            P[i * n + j] -= Ph[i] * Ph[j] / s
-    return clipped
 
 
 def record_clip(

@@ -66,15 +66,12 @@ def ekf_layout(params: OnlineEstimatorParams) -> tuple[int, int | None, int | No
 
 
 def _prior(params: OnlineEstimatorParams) -> tuple[list[float], list[float]]:
+    """(x0, prior variance of each state)."""
     n, i_s, i_b = ekf_layout(params)
     x0 = [1.0, 1.0] + [0.0] * (n - 2)
-    v = [params.prior_rel_std**2] * 2 + [0.0] * (n - 2)
-    if i_s is not None:
-        v[i_s] = (params.surface_prior_std_m / _MM) ** 2
     if i_b is not None:
         x0[i_b] = params.beta
-        v[i_b] = params.beta_prior_std**2
-    return x0, v
+    return x0, _variances(params, n, i_s, i_b)[0]
 
 
 def ekf_initial_state(params: OnlineEstimatorParams) -> list[float]:
@@ -83,17 +80,20 @@ def ekf_initial_state(params: OnlineEstimatorParams) -> list[float]:
     return initial_state(x0, v)
 
 
-def _walk(params: OnlineEstimatorParams, n, i_s, i_b) -> list[float]:
-    """Random-walk variance per second of each state."""
-    q = [
-        params.kappa_walk_rel_per_sqrt_s**2,
-        params.lam_walk_rel_per_sqrt_s**2,
-    ] + [0.0] * (n - 2)
+def _variances(
+    params: OnlineEstimatorParams, n: int, i_s: int | None, i_b: int | None
+) -> tuple[list[float], list[float]]:
+    """(prior variance, random-walk variance per second) of each state."""
+    p = params
+    v = [p.prior_rel_std**2] * 2 + [0.0] * (n - 2)
+    q = [p.kappa_walk_rel_per_sqrt_s**2, p.lam_walk_rel_per_sqrt_s**2] + v[2:]
     if i_s is not None:
-        q[i_s] = (params.surface_walk_m_per_sqrt_s / _MM) ** 2
+        v[i_s] = (p.surface_prior_std_m / _MM) ** 2
+        q[i_s] = (p.surface_walk_m_per_sqrt_s / _MM) ** 2
     if i_b is not None:
-        q[i_b] = params.beta_walk_per_sqrt_s**2
-    return q
+        v[i_b] = p.beta_prior_std**2
+        q[i_b] = p.beta_walk_per_sqrt_s**2
+    return v, q
 
 
 def ekf_step(
@@ -123,11 +123,12 @@ def ekf_step(
     eps = surface - z
     contact = sample.contact and eps > p.min_penetration_m
     if contact:
+        v0, walk = _variances(p, n, i_s, i_b)
         if not math.isnan(aux[T_UPDATE]):
             elapsed = t - aux[T_UPDATE]
-            _, v0 = _prior(p)
-            for i, q in enumerate(_walk(p, n, i_s, i_b)):
-                P[i * n + i] = min(P[i * n + i] + q * elapsed, max(v0[i], P[i * n + i]))
+            for i in range(n):
+                k = i * (n + 1)
+                P[k] = min(P[k] + walk[i] * elapsed, max(v0[i], P[k]))
         kappa, lam = x[0] * p.kappa_prior, x[1] * p.lam_prior
         eps_dot = sample.s_dot - z_dot
         e_b = eps**beta
@@ -139,7 +140,7 @@ def ekf_step(
         if i_b is not None:
             h[i_b] = predicted * math.log(eps)
         if gated_update(aux, x, P, saved, t, h, force - predicted, stiff, p):
-            reset_covariance(P, _prior(p)[1])
+            reset_covariance(P, v0)
         if i_b is not None:
             x[i_b] = min(max(x[i_b], 0.5), 3.0)
         if i_s is not None:
