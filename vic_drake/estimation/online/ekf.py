@@ -49,7 +49,7 @@ from vic_drake.estimation.online.core import (
     unpack,
 )
 from vic_drake.estimation.online.params import OnlineEstimatorParams
-from vic_drake.estimation.online.slope import slope_initial_state, slope_step
+from vic_drake.estimation.online.slope import SURFACE, advance, slope_initial_state
 
 _MM = 1e-3
 
@@ -119,9 +119,10 @@ def ekf_step(
         aux[IN_CONTACT] = 0.0
         est = make_estimate(aux, x, P, p, aux[S_PREV] + ds, False)
         return aux + x + P + saved, est
-    surface = sample.s + ds
+    s_in, s_dot, touching = sample
+    surface = s_in + ds
     eps = surface - z
-    contact = sample.contact and eps > p.min_penetration_m
+    contact = touching and eps > p.min_penetration_m
     if contact:
         v0, walk = _variances(p, n, i_s, i_b)
         if not math.isnan(aux[T_UPDATE]):
@@ -130,7 +131,7 @@ def ekf_step(
                 k = i * (n + 1)
                 P[k] = min(P[k] + walk[i] * elapsed, max(v0[i], P[k]))
         kappa, lam = x[0] * p.kappa_prior, x[1] * p.lam_prior
-        eps_dot = sample.s_dot - z_dot
+        eps_dot = s_dot - z_dot
         e_b = eps**beta
         stiff = kappa + lam * eps_dot
         predicted = stiff * e_b
@@ -144,13 +145,13 @@ def ekf_step(
         if i_b is not None:
             x[i_b] = min(max(x[i_b], 0.5), 3.0)
         if i_s is not None:
-            surface = sample.s + x[i_s] * _MM
+            surface = s_in + x[i_s] * _MM
         aux[N_UPDATES] += 1.0
         aux[T_UPDATE] = t
     else:
         confirm_reset(aux, x, P, saved, t, None, False, p.reset_confirm_s)
         if i_s is not None:
-            surface = sample.s + x[i_s] * _MM
+            surface = s_in + x[i_s] * _MM
     aux[IN_CONTACT] = 1.0 if contact else 0.0
     return aux + x + P + saved, make_estimate(aux, x, P, p, surface, contact)
 
@@ -172,16 +173,14 @@ def ekf_slope_step(
     """:func:`ekf_step` on the slope fit's surface when ``surface_z`` is NaN
     (arguments and result as :func:`ekf_step`)."""
     p = params
-    n, _, _ = ekf_layout(p)
-    size = state_size(n)
-    state = list(state)
-    ekf_state = state[:size]
-    fit, slope = slope_step(
-        state[size:], t, z, z_dot, force, p, surface_start=ekf_state[S_PREV]
-    )
+    if type(state) is not list:  # (slices of an array would be views)
+        state = list(state)
+    size = state_size(ekf_layout(p)[0])
+    fit = state[size:]
+    advance(fit, t, z, z_dot, force, p, state[S_PREV])
     if math.isnan(surface_z):
-        surface_z = slope.surface_z_m
-    ekf_state, est = ekf_step(ekf_state, t, z, z_dot, force, surface_z, p)
+        surface_z = fit[SURFACE]
+    ekf_state, est = ekf_step(state[:size], t, z, z_dot, force, surface_z, p)
     return ekf_state + fit, est
 
 
