@@ -29,7 +29,8 @@ Per sample (:func:`prepare`):
   (:func:`confirm_reset`).
 
 All arithmetic is on Python floats: the filters are 2 to 4 states, where
-numpy's per-call overhead would dominate a tick.
+numpy's per-call overhead would dominate a tick (the update itself:
+:mod:`vic_drake.estimation.online.kalman`).
 """
 
 from __future__ import annotations
@@ -37,6 +38,7 @@ from __future__ import annotations
 import math
 from typing import NamedTuple
 
+from vic_drake.estimation.online.kalman import scalar_update
 from vic_drake.estimation.online.params import OnlineEstimatorParams
 
 # Bookkeeping entries at the head of the state.
@@ -88,15 +90,6 @@ class Estimate(NamedTuple):
     in_contact: float
 
 
-class Sample(NamedTuple):
-    """A prepared sample: None from :func:`prepare` on a fault."""
-
-    dt: float  # since the last good sample, s (0 for the first)
-    s: float  # surface height, m (NaN if unknown)
-    s_dot: float  # surface rate, m/s
-    contact: bool  # force above threshold (the surface test is the filter's)
-
-
 def initial_state(x0: list[float], p0_diag: list[float]) -> list[float]:
     """A fresh state: no sample seen, x = x0, P = diag(p0_diag)."""
     n = len(x0)
@@ -116,7 +109,8 @@ def state_size(n: int) -> int:
 
 def unpack(state, n: int) -> tuple[list[float], list[float], list[float], list[float]]:
     """(aux, x, P, saved x and P) as new lists."""
-    state = list(state)
+    if type(state) is not list:  # A list's slices are new lists already.
+        state = list(state)
     a, b = AUX_SIZE + n, AUX_SIZE + n + n * n
     return state[:AUX_SIZE], state[AUX_SIZE:a], state[a:b], state[b:]
 
@@ -131,8 +125,15 @@ def prepare(
     kappa_hat: float,
     beta: float,
     p: OnlineEstimatorParams,
-) -> Sample | None:
-    """Bookkeeping of one sample (updates ``aux`` in place); None on a fault."""
+) -> tuple[float, float, bool] | None:
+    """Bookkeeping of one sample (updates ``aux`` in place).
+
+    Returns:
+        None on a fault, else (the surface height, m, NaN if unknown; the
+        surface rate, m/s; whether the force is above the contact
+        threshold: the penetration test is the filter's). A plain tuple:
+        a NamedTuple would cost a tenth of the RLS's tick.
+    """
     if not math.isfinite(t + z + z_dot + force) or not (
         math.isnan(aux[T_PREV]) or t > aux[T_PREV]
     ):
@@ -156,50 +157,7 @@ def prepare(
     else:
         aux[S_DOT] = 0.0
     aux[S_PREV] = s
-    return Sample(dt, s, aux[S_DOT], contact)
-
-
-def scalar_update(
-    x: list[float],
-    P: list[float],
-    h: list[float],
-    innovation: float,
-    r: float,
-    gate_sigma: float,
-) -> bool:
-    """Kalman update with one scalar measurement, in place; True if clipped.
-
-    The innovation is clipped at ``gate_sigma`` predicted standard
-    deviations (Huber-like): a spike moves x by a bounded step.
-    """
-    n = len(x)
-    if n == 2:  # The RLS and the plain EKF: unrolled (a third of the cost).
-        p00, p01, p11 = P[0], P[1], P[3]
-        a = p00 * h[0] + p01 * h[1]
-        b = p01 * h[0] + p11 * h[1]
-        s = h[0] * a + h[1] * b + r
-        bound = gate_sigma * math.sqrt(s)
-        clipped = abs(innovation) > bound
-        if clipped:
-            innovation = math.copysign(bound, innovation)
-        x[0] += a / s * innovation
-        x[1] += b / s * innovation
-        P[0] = p00 - a * a / s
-        P[1] = P[2] = p01 - a * b / s
-        P[3] = p11 - b * b / s
-        return clipped
-    Ph = [sum(P[i * n + j] * h[j] for j in range(n)) for i in range(n)]
-    s = sum(h[i] * Ph[i] for i in range(n)) + r
-    bound = gate_sigma * math.sqrt(s)
-    clipped = abs(innovation) > bound
-    if clipped:
-        innovation = math.copysign(bound, innovation)
-    for i in range(n):
-        x[i] += Ph[i] / s * innovation
-    for i in range(n):
-        for j in range(n):
-            P[i * n + j] -= Ph[i] * Ph[j] / s
-    return clipped
+    return s, aux[S_DOT], contact
 
 
 def record_clip(
@@ -334,7 +292,8 @@ def bound_parameters(x: list[float], max_rel_change: float) -> None:
     """Keeps the normalised kappa and lam (x[0], x[1]) in [1/m, m], in place."""
     lo = 1.0 / max_rel_change
     for i in (0, 1):
-        x[i] = min(max(x[i], lo), max_rel_change)
+        v = x[i]  # NaN stays NaN, as with min(max(v, lo), max_rel_change)
+        x[i] = lo if v < lo else max_rel_change if v > max_rel_change else v
 
 
 def make_estimate(
@@ -366,7 +325,6 @@ __all__ = [
     "AUX_SIZE",
     "OUTPUT_FIELDS",
     "Estimate",
-    "Sample",
     "bound_parameters",
     "cap_variances",
     "confirm_reset",

@@ -49,7 +49,7 @@ from vic_drake.estimation.online.core import (
     unpack,
 )
 from vic_drake.estimation.online.params import OnlineEstimatorParams
-from vic_drake.estimation.online.slope import slope_initial_state, slope_step
+from vic_drake.estimation.online.slope import SURFACE, advance, slope_initial_state
 
 _MM = 1e-3
 
@@ -66,15 +66,12 @@ def ekf_layout(params: OnlineEstimatorParams) -> tuple[int, int | None, int | No
 
 
 def _prior(params: OnlineEstimatorParams) -> tuple[list[float], list[float]]:
+    """(x0, prior variance of each state)."""
     n, i_s, i_b = ekf_layout(params)
     x0 = [1.0, 1.0] + [0.0] * (n - 2)
-    v = [params.prior_rel_std**2] * 2 + [0.0] * (n - 2)
-    if i_s is not None:
-        v[i_s] = (params.surface_prior_std_m / _MM) ** 2
     if i_b is not None:
         x0[i_b] = params.beta
-        v[i_b] = params.beta_prior_std**2
-    return x0, v
+    return x0, _variances(params, n, i_s, i_b)[0]
 
 
 def ekf_initial_state(params: OnlineEstimatorParams) -> list[float]:
@@ -83,17 +80,20 @@ def ekf_initial_state(params: OnlineEstimatorParams) -> list[float]:
     return initial_state(x0, v)
 
 
-def _walk(params: OnlineEstimatorParams, n, i_s, i_b) -> list[float]:
-    """Random-walk variance per second of each state."""
-    q = [
-        params.kappa_walk_rel_per_sqrt_s**2,
-        params.lam_walk_rel_per_sqrt_s**2,
-    ] + [0.0] * (n - 2)
+def _variances(
+    params: OnlineEstimatorParams, n: int, i_s: int | None, i_b: int | None
+) -> tuple[list[float], list[float]]:
+    """(prior variance, random-walk variance per second) of each state."""
+    p = params
+    v = [p.prior_rel_std**2] * 2 + [0.0] * (n - 2)
+    q = [p.kappa_walk_rel_per_sqrt_s**2, p.lam_walk_rel_per_sqrt_s**2] + v[2:]
     if i_s is not None:
-        q[i_s] = (params.surface_walk_m_per_sqrt_s / _MM) ** 2
+        v[i_s] = (p.surface_prior_std_m / _MM) ** 2
+        q[i_s] = (p.surface_walk_m_per_sqrt_s / _MM) ** 2
     if i_b is not None:
-        q[i_b] = params.beta_walk_per_sqrt_s**2
-    return q
+        v[i_b] = p.beta_prior_std**2
+        q[i_b] = p.beta_walk_per_sqrt_s**2
+    return v, q
 
 
 def ekf_step(
@@ -119,17 +119,19 @@ def ekf_step(
         aux[IN_CONTACT] = 0.0
         est = make_estimate(aux, x, P, p, aux[S_PREV] + ds, False)
         return aux + x + P + saved, est
-    surface = sample.s + ds
+    s_in, s_dot, touching = sample
+    surface = s_in + ds
     eps = surface - z
-    contact = sample.contact and eps > p.min_penetration_m
+    contact = touching and eps > p.min_penetration_m
     if contact:
+        v0, walk = _variances(p, n, i_s, i_b)
         if not math.isnan(aux[T_UPDATE]):
             elapsed = t - aux[T_UPDATE]
-            _, v0 = _prior(p)
-            for i, q in enumerate(_walk(p, n, i_s, i_b)):
-                P[i * n + i] = min(P[i * n + i] + q * elapsed, max(v0[i], P[i * n + i]))
+            for i in range(n):
+                k = i * (n + 1)
+                P[k] = min(P[k] + walk[i] * elapsed, max(v0[i], P[k]))
         kappa, lam = x[0] * p.kappa_prior, x[1] * p.lam_prior
-        eps_dot = sample.s_dot - z_dot
+        eps_dot = s_dot - z_dot
         e_b = eps**beta
         stiff = kappa + lam * eps_dot
         predicted = stiff * e_b
@@ -139,17 +141,17 @@ def ekf_step(
         if i_b is not None:
             h[i_b] = predicted * math.log(eps)
         if gated_update(aux, x, P, saved, t, h, force - predicted, stiff, p):
-            reset_covariance(P, _prior(p)[1])
+            reset_covariance(P, v0)
         if i_b is not None:
             x[i_b] = min(max(x[i_b], 0.5), 3.0)
         if i_s is not None:
-            surface = sample.s + x[i_s] * _MM
+            surface = s_in + x[i_s] * _MM
         aux[N_UPDATES] += 1.0
         aux[T_UPDATE] = t
     else:
         confirm_reset(aux, x, P, saved, t, None, False, p.reset_confirm_s)
         if i_s is not None:
-            surface = sample.s + x[i_s] * _MM
+            surface = s_in + x[i_s] * _MM
     aux[IN_CONTACT] = 1.0 if contact else 0.0
     return aux + x + P + saved, make_estimate(aux, x, P, p, surface, contact)
 
@@ -171,16 +173,14 @@ def ekf_slope_step(
     """:func:`ekf_step` on the slope fit's surface when ``surface_z`` is NaN
     (arguments and result as :func:`ekf_step`)."""
     p = params
-    n, _, _ = ekf_layout(p)
-    size = state_size(n)
-    state = list(state)
-    ekf_state = state[:size]
-    fit, slope = slope_step(
-        state[size:], t, z, z_dot, force, p, surface_start=ekf_state[S_PREV]
-    )
+    if type(state) is not list:  # (slices of an array would be views)
+        state = list(state)
+    size = state_size(ekf_layout(p)[0])
+    fit = state[size:]
+    advance(fit, t, z, z_dot, force, p, state[S_PREV])
     if math.isnan(surface_z):
-        surface_z = slope.surface_z_m
-    ekf_state, est = ekf_step(ekf_state, t, z, z_dot, force, surface_z, p)
+        surface_z = fit[SURFACE]
+    ekf_state, est = ekf_step(state[:size], t, z, z_dot, force, surface_z, p)
     return ekf_state + fit, est
 
 

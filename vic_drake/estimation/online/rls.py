@@ -87,11 +87,12 @@ def rls_step(
     if sample is None:
         aux[IN_CONTACT] = 0.0
         return aux + x + P + saved, make_estimate(aux, x, P, p, aux[S_PREV], False)
-    eps = sample.s - z
-    contact = sample.contact and eps > p.min_penetration_m
+    s_in, s_dot, touching = sample
+    eps = s_in - z
+    contact = touching and eps > p.min_penetration_m
     if contact:
         e_b = eps**p.beta
-        eps_dot = sample.s_dot - z_dot
+        eps_dot = s_dot - z_dot
         h = [p.kappa_prior * e_b, p.lam_prior * e_b * eps_dot]
         if not math.isnan(aux[T_UPDATE]):
             forget = math.exp(-min(t - aux[T_UPDATE], p.max_gap_s) / p.memory_s)
@@ -108,7 +109,7 @@ def rls_step(
     else:
         confirm_reset(aux, x, P, saved, t, None, False, p.reset_confirm_s)
     aux[IN_CONTACT] = 1.0 if contact else 0.0
-    return aux + x + P + saved, make_estimate(aux, x, P, p, sample.s, contact)
+    return aux + x + P + saved, make_estimate(aux, x, P, p, s_in, contact)
 
 
 __all__ = ["RLS_SIZE", "rls_initial_state", "rls_step"]

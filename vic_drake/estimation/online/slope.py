@@ -84,6 +84,8 @@ _S_OUT = _T_MEAN + 1  # the tracked surface, m (NaN: none)
 _V_OUT = _S_OUT + 1  # its rate, m/s
 _KAPPA = _V_OUT + 1  # F / eps^beta of the last valid solve (NaN: none)
 SLOPE_SIZE = _KAPPA + 1
+#: Index of the tracked surface in the state (:func:`advance`).
+SURFACE = _S_OUT
 
 
 class SlopeEstimate(NamedTuple):
@@ -196,17 +198,32 @@ def slope_step(
     Returns:
         (new state, :class:`SlopeEstimate`).
     """
-    p = params
     s = list(state)
+    advance(s, t, z, z_dot, force, params, surface_start)
+    return s, _estimate(s)
+
+
+def advance(
+    s: list[float],
+    t: float,
+    z: float,
+    z_dot: float,
+    force: float,
+    params: OnlineEstimatorParams,
+    surface_start: float = math.nan,
+) -> None:
+    """:func:`slope_step` on the state ``s`` in place, without the estimate
+    (its surface is ``s[SURFACE]``)."""
+    p = params
     if not math.isfinite(t + z + z_dot + force) or not (
         math.isnan(s[_T_LAST]) or t > s[_T_LAST]
     ):
-        return s, _estimate(s)
+        return
     dt = 0.0 if math.isnan(s[_T_LAST]) else t - s[_T_LAST]
     if force <= p.contact_threshold_N:
-        s = slope_initial_state()
+        s[:] = slope_initial_state()
         s[_T_LAST] = t
-        return s, _estimate(s)
+        return
     s[_T_LAST] = t
     if math.isnan(s[_T_REF]):
         s[_T_REF] = s[_T_START] = t
@@ -230,7 +247,6 @@ def slope_step(
             )
             s[_S_OUT] += dt * (v + 2.0 * wn * e)
             s[_V_OUT] += dt * wn * wn * e
-    return s, _estimate(s)
 
 
 def _estimate(s: list[float]) -> SlopeEstimate:
@@ -241,10 +257,12 @@ def _estimate(s: list[float]) -> SlopeEstimate:
 
 __all__ = [
     "MAX_PENETRATION_M",
+    "SURFACE",
     "MAX_SURFACE_ERROR_M",
     "SLOPE_SIZE",
     "SOLVE_EVERY",
     "SlopeEstimate",
+    "advance",
     "slope_initial_state",
     "slope_step",
 ]
