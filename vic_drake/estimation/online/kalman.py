@@ -114,8 +114,18 @@ def scalar_update_loops(
 ) -> bool:
     """:func:`scalar_update` for any n, by loops over P."""
     n = len(x)
-    Ph = [sum(P[i * n + j] * h[j] for j in range(n)) for i in range(n)]
-    s = sum(h[i] * Ph[i] for i in range(n)) + r
+    # Left-to-right sums, as written out above: ``sum()`` of floats is
+    # compensated from Python 3.12 on and would give other bits there.
+    Ph = []
+    for i in range(n):
+        acc = P[i * n] * h[0]
+        for j in range(1, n):
+            acc += P[i * n + j] * h[j]
+        Ph.append(acc)
+    s = h[0] * Ph[0]
+    for i in range(1, n):
+        s += h[i] * Ph[i]
+    s += r
     innovation, clipped = _gate(innovation, s, gate_sigma)
     for i in range(n):
         x[i] += Ph[i] / s * innovation
