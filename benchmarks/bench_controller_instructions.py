@@ -17,15 +17,11 @@ shared host; these counts repeat to 0.1 %. Needs valgrind.
 from __future__ import annotations
 
 import argparse
-import glob
 import os
-import re
-import shutil
 import subprocess
 import sys
-import tempfile
 
-from common import HERE, is_checkout, run_in_checkout, versions
+from common import HERE, callgrind_in_checkout, check_callgrind_baseline, versions
 
 
 def _worker(solver: str, warmup: int, ticks: int) -> None:
@@ -77,25 +73,11 @@ def _worker(solver: str, warmup: int, ticks: int) -> None:
 
 def _count(tree: str, solver: str, args) -> float:
     """Instructions per Diagram tick (FixValue excluded) of ``tree``."""
-    with tempfile.TemporaryDirectory() as tmp:
-        out = os.path.join(tmp, "callgrind.out")
-        command = ["valgrind", "--tool=callgrind", "--instr-atstart=no"]
-        command += [f"--callgrind-out-file={out}", sys.executable]
-        command += [os.path.abspath(__file__), "--worker", solver]
-        command += ["--warmup", str(args.warmup), "--ticks", str(args.ticks)]
-        done = run_in_checkout(tree, command)
-        ticks = re.search(r"^ticks (\d+)", done.stdout, re.M)
-        summaries = {}
-        for path in glob.glob(out + ".*"):
-            with open(path) as f:
-                text = f.read()
-            label = re.search(r"^desc: Trigger: .* (\w+)$", text, re.M)
-            summary = re.search(r"^summary: (\d+)", text, re.M)
-            if label and summary:
-                summaries[label.group(1)] = int(summary.group(1))
-        if ticks is None or set(summaries) != {"ticks", "fixvalue"}:
-            sys.exit(f"the run of {tree} failed:\n{done.stderr[-2000:]}")
-        return (summaries["ticks"] - summaries["fixvalue"]) / int(ticks.group(1))
+    worker = [solver, "--warmup", str(args.warmup), "--ticks", str(args.ticks)]
+    ticks, dumps = callgrind_in_checkout(tree, __file__, worker)
+    if set(dumps) != {"ticks", "fixvalue"}:
+        sys.exit(f"the run of {tree} dumped {sorted(dumps)}, not ticks and fixvalue")
+    return (dumps["ticks"] - dumps["fixvalue"]) / ticks
 
 
 def main() -> int:
@@ -117,10 +99,7 @@ def main() -> int:
     for name in solvers:
         if name not in ("exact", "osqp", "clarabel"):
             parser.error(f"--solvers: {name!r} is not exact, osqp or clarabel")
-    if shutil.which("valgrind") is None:
-        parser.error("valgrind is not installed (Debian: apt-get install valgrind)")
-    if args.baseline is not None and not is_checkout(args.baseline):
-        parser.error(f"--baseline must be a checkout of vic_drake; got {args.baseline}")
+    check_callgrind_baseline(parser, args.baseline)
     print(versions())
     print(
         f"controller Diagram (VS-VF, log inputs), {args.ticks} ticks after "

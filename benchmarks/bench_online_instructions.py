@@ -14,16 +14,12 @@ on a shared host; these counts repeat to 0.1 %. Needs valgrind.
 from __future__ import annotations
 
 import argparse
-import glob
 import os
-import re
-import shutil
 import subprocess
 import sys
-import tempfile
 
 import numpy as np
-from common import HERE, is_checkout, run_in_checkout, versions
+from common import HERE, callgrind_in_checkout, check_callgrind_baseline, versions
 
 
 def _worker(warmup: int, ticks: int) -> None:
@@ -57,25 +53,9 @@ def _worker(warmup: int, ticks: int) -> None:
 
 def _count(tree: str, args) -> dict[str, float]:
     """Instructions per tick of ``tree``, by dump label."""
-    with tempfile.TemporaryDirectory() as tmp:
-        out = os.path.join(tmp, "callgrind.out")
-        command = ["valgrind", "--tool=callgrind", "--instr-atstart=no"]
-        command += [f"--callgrind-out-file={out}", sys.executable]
-        command += [os.path.abspath(__file__), "--worker"]
-        command += ["--warmup", str(args.warmup), "--ticks", str(args.ticks)]
-        done = run_in_checkout(tree, command)
-        ticks = re.search(r"^ticks (\d+)", done.stdout, re.M)
-        counts = {}
-        for path in glob.glob(out + ".*"):
-            with open(path) as f:
-                text = f.read()
-            label = re.search(r"^desc: Trigger: .* (L\d+V\d+)$", text, re.M)
-            summary = re.search(r"^summary: (\d+)", text, re.M)
-            if label and summary:
-                counts[label.group(1)] = int(summary.group(1)) / int(ticks.group(1))
-        if ticks is None or not counts:
-            sys.exit(f"the run of {tree} failed:\n{done.stderr[-2000:]}")
-        return counts
+    worker = ["--warmup", str(args.warmup), "--ticks", str(args.ticks)]
+    ticks, dumps = callgrind_in_checkout(tree, __file__, worker)
+    return {label: count / ticks for label, count in dumps.items()}
 
 
 def main() -> int:
@@ -92,10 +72,7 @@ def main() -> int:
     if args.worker:
         _worker(args.warmup, args.ticks)
         return 0
-    if shutil.which("valgrind") is None:
-        parser.error("valgrind is not installed (Debian: apt-get install valgrind)")
-    if args.baseline is not None and not is_checkout(args.baseline):
-        parser.error(f"--baseline must be a checkout of vic_drake; got {args.baseline}")
+    check_callgrind_baseline(parser, args.baseline)
     from bench_online_estimator import VARIANTS, logs
 
     print(versions())

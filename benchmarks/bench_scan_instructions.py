@@ -18,15 +18,11 @@ each run takes a few minutes.
 from __future__ import annotations
 
 import argparse
-import glob
 import os
-import re
-import shutil
 import subprocess
 import sys
-import tempfile
 
-from common import HERE, is_checkout, run_in_checkout, versions
+from common import HERE, callgrind_in_checkout, check_callgrind_baseline, versions
 
 
 def _worker(controller: str, t0: float, t1: float, online: bool) -> None:
@@ -63,21 +59,12 @@ def _worker(controller: str, t0: float, t1: float, online: bool) -> None:
 
 def _count(tree: str, args) -> float:
     """Instructions per tick of the scan of ``tree``."""
-    with tempfile.TemporaryDirectory() as tmp:
-        out = os.path.join(tmp, "callgrind.out")
-        command = ["valgrind", "--tool=callgrind", "--instr-atstart=no"]
-        command += [f"--callgrind-out-file={out}", sys.executable]
-        command += [os.path.abspath(__file__), "--worker", args.controller]
-        command += ["--from", str(args.t0), "--to", str(args.t1)]
-        command += ["--online"] if args.online else []
-        done = run_in_checkout(tree, command)
-        ticks = re.search(r"^ticks (\d+)", done.stdout, re.M)
-        dumps = [p for p in glob.glob(out + ".*") if not p.endswith(out)]
-        if ticks is None or not dumps:
-            sys.exit(f"the run of {tree} failed:\n{done.stderr[-2000:]}")
-        with open(sorted(dumps)[0]) as f:
-            summary = re.search(r"^summary: (\d+)", f.read(), re.M)
-        return int(summary.group(1)) / int(ticks.group(1))
+    worker = [args.controller, "--from", str(args.t0), "--to", str(args.t1)]
+    worker += ["--online"] if args.online else []
+    ticks, dumps = callgrind_in_checkout(tree, __file__, worker)
+    if "window" not in dumps:
+        sys.exit(f"the run of {tree} dumped {sorted(dumps)}, not the scan window")
+    return dumps["window"] / ticks
 
 
 def main() -> int:
@@ -96,10 +83,7 @@ def main() -> int:
     if args.worker:
         _worker(args.worker, args.t0, args.t1, args.online)
         return 0
-    if shutil.which("valgrind") is None:
-        parser.error("valgrind is not installed (Debian: apt-get install valgrind)")
-    if args.baseline is not None and not is_checkout(args.baseline):
-        parser.error(f"--baseline must be a checkout of vic_drake; got {args.baseline}")
+    check_callgrind_baseline(parser, args.baseline)
     print(versions())
     online = " (online estimator)" if args.online else ""
     print(

@@ -3,12 +3,16 @@
 from __future__ import annotations
 
 import argparse
+import glob
 import importlib.metadata
 import importlib.util
 import os
 import platform
+import re
+import shutil
 import subprocess
 import sys
+import tempfile
 
 import numpy as np
 
@@ -74,3 +78,42 @@ def run_sections(sections: dict, doc: str) -> None:
     for name in args.section or sections:
         print(f"== {name}")
         sections[name](data_dir)
+
+
+def check_callgrind_baseline(parser: argparse.ArgumentParser, baseline) -> None:
+    """Ends the command with a usage error when valgrind is missing or
+    ``baseline`` (if given) is not a checkout of vic_drake."""
+    if shutil.which("valgrind") is None:
+        parser.error("valgrind is not installed (Debian: apt-get install valgrind)")
+    if baseline is not None and not is_checkout(baseline):
+        parser.error(f"--baseline must be a checkout of vic_drake; got {baseline}")
+
+
+def callgrind_in_checkout(
+    tree: str, script: str, worker_args: list[str]
+) -> tuple[int, dict[str, int]]:
+    """Runs ``script --worker ...`` of checkout ``tree`` under callgrind.
+
+    The worker switches the instrumentation on and off itself, dumps each
+    measured part under a label (``callgrind_control -d LABEL``) and prints
+    ``ticks N``. Returns (N, {label: instructions of its dump}); ends the
+    command with the run's stderr when either is missing.
+    """
+    with tempfile.TemporaryDirectory() as tmp:
+        out = os.path.join(tmp, "callgrind.out")
+        command = ["valgrind", "--tool=callgrind", "--instr-atstart=no"]
+        command += [f"--callgrind-out-file={out}", sys.executable]
+        command += [os.path.abspath(script), "--worker", *worker_args]
+        done = run_in_checkout(tree, command)
+        ticks = re.search(r"^ticks (\d+)", done.stdout, re.M)
+        dumps = {}
+        for path in glob.glob(out + ".*"):
+            with open(path) as f:
+                text = f.read()
+            label = re.search(r"^desc: Trigger: .* (\S+)$", text, re.M)
+            summary = re.search(r"^summary: (\d+)", text, re.M)
+            if label and summary:
+                dumps[label.group(1)] = int(summary.group(1))
+        if ticks is None or not dumps:
+            sys.exit(f"the run of {tree} failed:\n{done.stderr[-2000:]}")
+        return int(ticks.group(1)), dumps
