@@ -71,6 +71,7 @@ def distribution_figure(rows: pd.DataFrame, force_limit_N: float):
         ax.set_ylabel(label)
     axes[0].axhline(force_limit_N, color="r", ls="--", label="force limit")
     axes[0].legend()
+    fig.tight_layout()  # The second axis label clears the first plot.
     return fig
 
 
