@@ -253,19 +253,21 @@ def gated_update(
     h: list[float],
     innovation: float,
     stiffness: float,
+    prior_var: list[float],
     p: OnlineEstimatorParams,
-) -> bool:
+) -> None:
     """One update in contact, in place: :func:`scalar_update` with the gate,
     :func:`record_clip` (``stiffness`` = kappa + lam eps_dot of the estimate
-    before the update; <= 0 is no evidence), :func:`bound_parameters` and
-    :func:`confirm_reset`. True when the caller must reset P to its prior
-    (:func:`reset_covariance`)."""
+    before the update; <= 0 is no evidence), :func:`bound_parameters`,
+    :func:`confirm_reset`, and P back to ``prior_var`` when record_clip asks
+    for it (:func:`reset_covariance`)."""
     before = x + P
     clipped = scalar_update(x, P, h, innovation, p.noise_std_N**2, p.gate_sigma)
     reset = record_clip(aux, clipped, t, p.clip_reset_s, p.max_gap_s, stiffness > 0.0)
     bound_parameters(x, p.max_rel_change)
     confirm_reset(aux, x, P, saved, t, before, reset, p.reset_confirm_s)
-    return reset
+    if reset:
+        reset_covariance(P, prior_var)
 
 
 def reset_covariance(P: list[float], prior_var: list[float]) -> None:

@@ -44,7 +44,6 @@ from vic_drake.estimation.online.core import (
     initial_state,
     make_estimate,
     prepare,
-    reset_covariance,
     state_size,
     unpack,
 )
@@ -140,18 +139,15 @@ def ekf_step(
             h[i_s] = stiff * beta * eps ** (beta - 1.0) * _MM
         if i_b is not None:
             h[i_b] = predicted * math.log(eps)
-        if gated_update(aux, x, P, saved, t, h, force - predicted, stiff, p):
-            reset_covariance(P, v0)
+        gated_update(aux, x, P, saved, t, h, force - predicted, stiff, v0, p)
         if i_b is not None:
             x[i_b] = min(max(x[i_b], 0.5), 3.0)
-        if i_s is not None:
-            surface = s_in + x[i_s] * _MM
         aux[N_UPDATES] += 1.0
         aux[T_UPDATE] = t
     else:
         confirm_reset(aux, x, P, saved, t, None, False, p.reset_confirm_s)
-        if i_s is not None:
-            surface = s_in + x[i_s] * _MM
+    if i_s is not None:  # The offset as updated, or as put back.
+        surface = s_in + x[i_s] * _MM
     aux[IN_CONTACT] = 1.0 if contact else 0.0
     return aux + x + P + saved, make_estimate(aux, x, P, p, surface, contact)
 

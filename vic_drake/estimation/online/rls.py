@@ -41,7 +41,6 @@ from vic_drake.estimation.online.core import (
     initial_state,
     make_estimate,
     prepare,
-    reset_covariance,
     unpack,
 )
 from vic_drake.estimation.online.params import OnlineEstimatorParams
@@ -102,8 +101,8 @@ def rls_step(
         innovation = force - (h[0] * x[0] + h[1] * x[1])
         # Stiffness of the estimate at this rate (<= 0: it predicts a pull).
         stiff = p.kappa_prior * x[0] + p.lam_prior * x[1] * eps_dot
-        if gated_update(aux, x, P, saved, t, h, innovation, stiff, p):
-            reset_covariance(P, [p.prior_rel_std**2] * RLS_SIZE)
+        prior_var = [p.prior_rel_std**2] * RLS_SIZE
+        gated_update(aux, x, P, saved, t, h, innovation, stiff, prior_var, p)
         aux[N_UPDATES] += 1.0
         aux[T_UPDATE] = t
     else:

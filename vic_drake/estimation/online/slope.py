@@ -257,10 +257,10 @@ def _estimate(s: list[float]) -> SlopeEstimate:
 
 __all__ = [
     "MAX_PENETRATION_M",
-    "SURFACE",
     "MAX_SURFACE_ERROR_M",
     "SLOPE_SIZE",
     "SOLVE_EVERY",
+    "SURFACE",
     "SlopeEstimate",
     "advance",
     "slope_initial_state",
