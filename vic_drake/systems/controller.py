@@ -42,6 +42,7 @@ from vic_drake.systems.signals import (
     STATUS_FIELDS,
     TANK_ENERGY,
     TANK_FIELDS,
+    widths,
 )
 from vic_drake.systems.stiffness_qp import StiffnessQpSystem
 from vic_drake.systems.tank import EnergyTankSystem
@@ -150,7 +151,7 @@ def MakeVariableImpedanceController(
         "ft_sensor.force_W": MEASURED_FORCE,
     }
     measurement = builder.AddNamedSystem(
-        "measurement", Multiplexer([part.stop - part.start for part in parts.values()])
+        "measurement", Multiplexer(widths(parts.values()))
     )
     builder.Connect(measurement.get_output_port(0), ref.get_measurement_input_port())
     if online:  # The estimator reads the same vector.
@@ -163,13 +164,7 @@ def MakeVariableImpedanceController(
     # Multiplexer: one port evaluation per tick instead of three.
     qp_inputs = builder.AddNamedSystem(
         "qp_inputs",
-        Multiplexer(
-            [
-                QP_IN_TARGET.stop - QP_IN_TARGET.start,
-                QP_IN_REFERENCE_TICK.stop - QP_IN_REFERENCE_TICK.start,
-                1,
-            ]
-        ),
+        Multiplexer(widths((QP_IN_TARGET, QP_IN_REFERENCE_TICK)) + [1]),
     )
     builder.Connect(qp_inputs.get_output_port(0), qp.get_inputs_input_port())
     builder.ExportInput(qp_inputs.get_input_port(0), "target_position")

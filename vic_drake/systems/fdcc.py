@@ -26,6 +26,7 @@ from vic_drake.systems.signals import (
     FDCC_IN_TARGET_POSITION,
     FDCC_INPUT_PARTS,
     FDCC_INPUTS_SIZE,
+    widths,
 )
 
 
@@ -165,7 +166,7 @@ def AddFdccInputs(builder, fdcc: FdccController, *, name: str = "fdcc_inputs"):
         for the caller to connect or fix.
     """
     mux = builder.AddNamedSystem(
-        name, Multiplexer([part.stop - part.start for _, part in FDCC_INPUT_PARTS])
+        name, Multiplexer(widths(part for _, part in FDCC_INPUT_PARTS))
     )
     builder.Connect(mux.get_output_port(0), fdcc.get_inputs_input_port())
     return {part: mux.get_input_port(i) for i, (part, _) in enumerate(FDCC_INPUT_PARTS)}

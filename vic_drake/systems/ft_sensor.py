@@ -202,7 +202,9 @@ class ForceTorqueSensor(LeafSystem):
         return X_WC.rotation().matrix()
 
     def _R_WS(self, context) -> np.ndarray:
-        return self._R_WC(context) @ self._R_CS
+        """The orientation of the sensor frame S in W, from the inputs."""
+        R_WC = self._R_WC(context)
+        return R_WC if self._identity_CS else R_WC @ self._R_CS
 
     def tared_wrench(self, context) -> np.ndarray:
         """The noise-free, undelayed tared wrench ``[tau; f]`` in S now."""
@@ -225,8 +227,7 @@ class ForceTorqueSensor(LeafSystem):
             return None
 
     def _update(self, context, discrete_state):
-        R_WC = self._R_WC(context)
-        R_WS = R_WC if self._identity_CS else R_WC @ self._R_CS
+        R_WS = self._R_WS(context)
         F_S = self._reaction_port.Eval(context)[self._joint].get_coeffs()
         # = tared_sensor_wrench(F_S, R_WS, ...), one product per tick.
         sample = F_S - self._static_per_g @ (R_WS.T @ self._gravity_W)

@@ -250,7 +250,7 @@ class ForceReferenceSystem(LeafSystem):
         f_W = measured[MEASURED_FORCE]
         filt = context.get_discrete_state(self._filter_index).value().tolist()
         # A sum of floats is finite iff every term is (inf - inf = nan).
-        if not math.isfinite(sum(p_WP) + sum(v_WP) + sum(f_W)):
+        if not math.isfinite(sum(measured)):
             # Restart the filter: the next good sample only records its height
             # (no rate spike across the gap).
             filt[0] = 0.0

@@ -107,6 +107,13 @@ FDCC_INPUT_PARTS = (
     ("target_force", FDCC_IN_TARGET_FORCE),
 )
 
+
+def widths(parts) -> list[int]:
+    """The lengths of the slices ``parts``, in order (a Multiplexer's input
+    sizes for the vector they tile)."""
+    return [part.stop - part.start for part in parts]
+
+
 #: The "qp_tick" port: the QP's last tick as the tank integrates it.
 #: e = x_d - x (3, m), e_dot = -x_dot (3, m/s), K (3, N/m), the damping D
 #: the tick used (3, N s/m: 2 zeta sqrt of the previous tick's K), and

@@ -39,7 +39,6 @@ from vic_drake.systems.signals import (
     REF_PENETRATION,
     REF_PROBE_POSITION,
     REF_PROBE_VELOCITY,
-    REFERENCES_SIZE,
     STATUS_FALLBACK_COUNT,
     STATUS_FIELDS,
     STATUS_QP_OK,
@@ -158,7 +157,7 @@ class StiffnessQpSystem(LeafSystem):
             zeta2 * math.sqrt(max(k_prev[2], 0.0)),
         )
         # A sum of floats is finite iff every term is (inf - inf = nan).
-        total = sum(p_WP) + sum(v_WP) + sum(x_d) + sum(refs[:REFERENCES_SIZE]) + energy
+        total = sum(inputs)  # x_d, the references, p_WP, v_WP and T
         fault = not math.isfinite(total) or refs[REF_FAULT] > 0.5
         e = e_dot = (0.0, 0.0, 0.0)
         ok, solve_time = True, 0.0
