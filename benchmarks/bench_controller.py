@@ -36,13 +36,12 @@ Usage:
 from __future__ import annotations
 
 import argparse
-import importlib.metadata
 import math
 import os
-import platform
 import time
 
 import numpy as np
+from common import run_as_vic_drake, versions
 
 from vic_drake.control.params import (
     ControllerParams,
@@ -71,14 +70,6 @@ LOOP_US = 2000.0
 #: The solvers a scenario can select (StiffnessQpParams.solver): the Diagram
 #: path is measured for these.
 SCENARIO_SOLVERS = ("exact", "osqp", "clarabel")
-
-
-def versions() -> str:
-    """Drake and Python versions, printed with every figure."""
-    return (
-        f"drake {importlib.metadata.version('drake')}, "
-        f"python {platform.python_version()}, numpy {np.__version__}"
-    )
 
 
 def inputs(n: int, phantom):
@@ -228,6 +219,7 @@ def bench_diagram(params: ControllerParams, phantom, rows, ticks: int):
 
 
 def main():
+    run_as_vic_drake()
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--ticks", type=int, default=5000)
     parser.add_argument("--diagram-ticks", type=int, default=2000)

@@ -38,7 +38,7 @@ import time
 from collections import defaultdict
 from dataclasses import replace
 
-from common import HERE, is_checkout, run_in_checkout, versions
+from common import HERE, is_checkout, run_as_vic_drake, run_in_checkout, versions
 
 
 def plant_ceiling_rtf(scenario, duration_s: float) -> tuple[float, float]:
@@ -190,6 +190,10 @@ def main() -> None:
     if args.worker:
         _worker(args)
         return
+    if args.baseline is None:
+        # In this process: the allocator vic-drake runs scans with. (With
+        # --baseline each checkout's workers get their own.)
+        run_as_vic_drake()
     print(versions())
     if args.baseline is not None:
         _compare(args)

@@ -17,12 +17,26 @@ import tempfile
 import numpy as np
 
 
+def allocator_in_use() -> str:
+    """The allocator this process runs with: mimalloc when it is mapped into the
+    process, else the C library's (with glibc's tunables, when set)."""
+    try:
+        with open("/proc/self/maps") as maps:
+            if "libmimalloc" in maps.read():
+                return "mimalloc"
+    except OSError:
+        pass
+    tunables = os.environ.get("GLIBC_TUNABLES")
+    return f"glibc ({tunables})" if tunables else "glibc (defaults)"
+
+
 def versions() -> str:
-    """Drake, Python and numpy versions and the core count, for a figure's header."""
+    """Drake, Python and numpy versions, the core count and the allocator, for a
+    figure's header."""
     return (
         f"drake {importlib.metadata.version('drake')}, "
         f"python {platform.python_version()}, numpy {np.__version__}, "
-        f"{os.cpu_count()} cores"
+        f"{os.cpu_count()} cores, allocator {allocator_in_use()}"
     )
 
 
@@ -50,6 +64,19 @@ def checkout_environment(tree: str) -> dict[str, str]:
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module.tuned_environment(env) if module.uses_glibc() else env
+
+
+def run_as_vic_drake() -> None:
+    """Restarts this benchmark with this checkout's environment
+    (:func:`checkout_environment`: the allocator ``vic-drake`` and the campaign
+    workers run with), so an in-process figure is the one a scan process
+    gives. At most once; ``VIC_DRAKE_ALLOCATOR=glibc`` measures glibc's."""
+    env = checkout_environment(HERE)
+    names = ("GLIBC_TUNABLES", "LD_PRELOAD")
+    if all(env.get(n) == os.environ.get(n) for n in names):
+        return
+    sys.stdout.flush()
+    os.execve(sys.executable, list(sys.orig_argv), env)
 
 
 def run_in_checkout(tree: str, command: list[str]) -> subprocess.CompletedProcess:

@@ -1,4 +1,4 @@
-"""glibc's malloc cache setting: merged into GLIBC_TUNABLES, set once at start."""
+"""The scan processes' allocator: mimalloc preloaded and glibc's cache enlarged, set once at start."""
 
 import os
 import subprocess
@@ -8,19 +8,29 @@ from pathlib import Path
 import pytest
 
 from vic_drake.malloc_tuning import (
+    ALLOCATOR_VAR,
     ENV_VAR,
+    PRELOAD_VAR,
     TUNABLES,
+    allocator,
     is_tuned,
+    mimalloc_library,
     tuned_environment,
+    tuned_preload,
     tuned_tunables,
     uses_glibc,
 )
 
 ROOT = Path(__file__).resolve().parents[1]
 OURS = ":".join(f"{name}={value}" for name, value in TUNABLES)
+MIMALLOC = mimalloc_library()
 needs_glibc = pytest.mark.skipif(
     not (uses_glibc() and Path("/proc/self/environ").exists()),
     reason="glibc on Linux only",
+)
+needs_mimalloc = pytest.mark.skipif(
+    MIMALLOC is None or not uses_glibc(),
+    reason="cmeel-mimalloc is installed on Linux only",
 )
 
 
@@ -35,27 +45,67 @@ def test_the_tunables_are_added_to_what_is_there():
 def test_a_tunable_set_by_the_user_keeps_its_value():
     mine = "glibc.malloc.tcache_count=7:glibc.malloc.mxfast=0"
     assert tuned_tunables(mine) == mine
-    assert is_tuned({ENV_VAR: mine})
-    assert not is_tuned({})
-    assert not is_tuned({ENV_VAR: "glibc.malloc.mxfast=0"})
+    glibc = {ALLOCATOR_VAR: "glibc"}
+    assert is_tuned({**glibc, ENV_VAR: mine})
+    assert not is_tuned(glibc)
+    assert not is_tuned({**glibc, ENV_VAR: "glibc.malloc.mxfast=0"})
 
 
 def test_tuned_environment_copies():
     env = {"A": "1"}
     tuned = tuned_environment(env)
     assert env == {"A": "1"}
-    assert tuned == {"A": "1", ENV_VAR: OURS}
+    expected = {"A": "1", ENV_VAR: OURS}
+    if MIMALLOC is not None:
+        expected[PRELOAD_VAR] = MIMALLOC
+    assert tuned == expected
     assert is_tuned(tuned)
+    assert not is_tuned(env)
+
+
+@needs_mimalloc
+def test_mimalloc_is_preloaded_unless_the_user_chose_otherwise():
+    assert Path(MIMALLOC).is_file() and "mimalloc" in Path(MIMALLOC).name
+    assert tuned_preload({}) == MIMALLOC
+    assert tuned_preload({PRELOAD_VAR: ""}) == MIMALLOC  # empty: nothing chosen
+    # A user's own preload is kept as it is, and counts as tuned.
+    assert tuned_preload({PRELOAD_VAR: "/opt/lib/libjemalloc.so"}) == (
+        "/opt/lib/libjemalloc.so"
+    )
+    assert is_tuned({PRELOAD_VAR: "/opt/lib/libjemalloc.so", ENV_VAR: OURS})
+    # glibc asked for: the tunables only.
+    glibc = tuned_environment({ALLOCATOR_VAR: "glibc"})
+    assert PRELOAD_VAR not in glibc and glibc[ENV_VAR] == OURS
+    assert is_tuned(glibc)
+    assert tuned_environment({ALLOCATOR_VAR: " MiMalloc "})[PRELOAD_VAR] == MIMALLOC
+
+
+def test_an_unknown_allocator_is_named_with_the_choices():
+    assert allocator({}) == "mimalloc"
+    assert allocator({ALLOCATOR_VAR: "glibc"}) == "glibc"
+    with pytest.raises(ValueError, match="'tcmalloc': choose from mimalloc, glibc"):
+        tuned_environment({ALLOCATOR_VAR: "tcmalloc"})
 
 
 def _environ_at_exec():
-    """Python code printing GLIBC_TUNABLES as the kernel started the process with it."""
+    """Python code printing GLIBC_TUNABLES as the kernel started the process
+    with it, and whether mimalloc is mapped into the process."""
     return (
         "import sys;"
         "env = dict(e.split(b'=', 1) for e in"
         " open('/proc/self/environ', 'rb').read().split(b'\\0') if b'=' in e);"
-        f"print('exec:', env.get(b'{ENV_VAR}', b'').decode())"
+        f"print('exec:', env.get(b'{ENV_VAR}', b'').decode());"
+        "print('mimalloc:', 'libmimalloc' in open('/proc/self/maps').read())"
     )
+
+
+def _without_ours(**extra):
+    env = {
+        k: v
+        for k, v in os.environ.items()
+        if k not in (ENV_VAR, PRELOAD_VAR, ALLOCATOR_VAR)
+    }
+    return {**env, **extra}
 
 
 def _run(code, env):
@@ -69,35 +119,63 @@ def _run(code, env):
 
 @needs_glibc
 def test_reexec_restarts_once_with_the_tunables_in_the_start_environment():
-    env = {k: v for k, v in os.environ.items() if k != ENV_VAR}
     code = (
         "import vic_drake.malloc_tuning as m;"
         "print('start');"
         "m.reexec_tuned();" + _environ_at_exec()
     )
     # "start" twice: the first process printed it, then was replaced.
-    assert _run(code, env) == ["start", "start", f"exec: {OURS}"]
+    mapped = f"mimalloc: {MIMALLOC is not None}"
+    assert _run(code, _without_ours()) == ["start", "start", f"exec: {OURS}", mapped]
 
 
 @needs_glibc
 def test_reexec_leaves_a_users_setting_alone():
-    env = {**os.environ, ENV_VAR: "glibc.malloc.tcache_count=7"}
+    env = _without_ours(**{ENV_VAR: "glibc.malloc.tcache_count=7"})
     code = "import vic_drake.malloc_tuning as m;m.reexec_tuned();" + _environ_at_exec()
-    assert _run(code, env) == ["exec: glibc.malloc.tcache_count=7"]
+    mapped = f"mimalloc: {MIMALLOC is not None}"
+    # Restarted for the allocator (when installed), the tunable kept.
+    assert _run(code, env)[-2:] == ["exec: glibc.malloc.tcache_count=7", mapped]
+    env = _without_ours(
+        **{ENV_VAR: "glibc.malloc.tcache_count=7", ALLOCATOR_VAR: "glibc"}
+    )
+    assert _run(code, env) == ["exec: glibc.malloc.tcache_count=7", "mimalloc: False"]
 
 
 @needs_glibc
 def test_the_command_line_restarts_tuned_and_then_runs_the_command():
-    env = {k: v for k, v in os.environ.items() if k != ENV_VAR}
     code = (
         "import sys;"
         "from vic_drake.cli import main;"
         + _environ_at_exec()
         + ";sys.argv = ['vic-drake', '--version'];main()"
     )
-    lines = _run(code, env)
-    assert lines[:2] == ["exec: ", f"exec: {OURS}"]
-    assert lines[2].startswith("vic-drake ")
+    lines = _run(code, _without_ours())
+    assert lines[:4] == [
+        "exec: ",
+        "mimalloc: False",
+        f"exec: {OURS}",
+        f"mimalloc: {MIMALLOC is not None}",
+    ]
+    assert lines[4].startswith("vic-drake ")
+
+
+def test_the_command_line_names_an_unknown_allocator():
+    env = {**_without_ours(**{ALLOCATOR_VAR: "tcmalloc"}), "PYTHONPATH": str(ROOT)}
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            "import sys; from vic_drake.cli import main; sys.exit(main())",
+        ],
+        env=env,
+        capture_output=True,
+        text=True,
+    )
+    assert done.returncode == 2
+    assert done.stderr.strip() == (
+        f"vic-drake: error: {ALLOCATOR_VAR}='tcmalloc': choose from mimalloc, glibc"
+    )
 
 
 def test_the_command_line_called_as_a_function_does_not_restart(capsys):
@@ -109,17 +187,36 @@ def test_the_command_line_called_as_a_function_does_not_restart(capsys):
     assert capsys.readouterr().out.startswith("vic-drake ")
 
 
-@needs_glibc
-def test_local_campaign_workers_start_with_the_tunables():
+def test_the_campaign_leaves_the_session_environment_alone():
+    """Dask's pre-spawn settings would stay in this process's os.environ (and
+    reach every program it starts later); the engine sets none."""
     from vic_drake.experiments.campaign.engine import _client
 
+    before = {k: os.environ.get(k) for k in (ENV_VAR, PRELOAD_VAR)}
     client, cluster = _client(1, None)
     try:
-        at_exec = client.run(
-            lambda: open("/proc/self/environ", "rb").read().split(b"\0")
-        )
+        client.run(lambda: None)
     finally:
         client.close()
         cluster.close()
-    (environ,) = at_exec.values()
-    assert f"{ENV_VAR}={OURS}".encode() in environ
+    assert {k: os.environ.get(k) for k in (ENV_VAR, PRELOAD_VAR)} == before
+
+
+def test_each_campaign_run_process_starts_with_the_allocator(monkeypatch):
+    import vic_drake.experiments.campaign.run as run
+
+    seen = {}
+
+    def fake_run(args, **kwargs):
+        seen.update(kwargs)
+        return subprocess.CompletedProcess(args, 1, b"", b"stopped by the test")
+
+    monkeypatch.setattr(run.subprocess, "run", fake_run)
+    plan = run.RunPlan.__new__(run.RunPlan)
+    monkeypatch.setattr(run, "failed_row", lambda plan, error, **kw: {"error": error})
+    assert "stopped by the test" in run.execute_run_in_child(plan)["error"]
+    assert seen["env"] == tuned_environment()
+    # A bad allocator name on the worker's machine: the run's error says so.
+    monkeypatch.setenv(ALLOCATOR_VAR, "tcmalloc")
+    error = run.execute_run_in_child(plan)["error"]
+    assert error == f"{ALLOCATOR_VAR}='tcmalloc': choose from mimalloc, glibc"

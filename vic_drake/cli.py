@@ -55,9 +55,13 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     if argv is None:
-        # Run as the program: restart once with glibc's malloc cache enlarged
+        # Run as the program: restart once with the scan processes' allocator
         # (vic_drake.malloc_tuning; same results, less allocator work).
-        reexec_tuned()
+        try:
+            reexec_tuned()
+        except ValueError as exc:
+            print(f"vic-drake: error: {exc}", file=sys.stderr)
+            return 2
     parser = build_parser()
     args = parser.parse_args(argv)
     try:

@@ -36,7 +36,7 @@ from vic_drake.experiments.campaign.plan import RunPlan, plan_campaign
 from vic_drake.experiments.campaign.run import failed_row
 from vic_drake.experiments.campaign.spec import CampaignSpec, load_campaign_spec
 from vic_drake.experiments.campaign.stats import per_controller
-from vic_drake.malloc_tuning import ENV_VAR, tuned_tunables
+from vic_drake.malloc_tuning import tuned_environment
 from vic_drake.scenario import dumps_scenario, load_scenario
 
 
@@ -125,15 +125,13 @@ def _client(workers: int | None, scheduler: str | None):
                 f"cannot reach the Dask scheduler {scheduler!r}: {exc}"
             ) from None
     n = workers or os.cpu_count() or 1
-    # Set before each worker process starts (glibc reads it only then).
-    pre_spawn = dict(dask.config.get("distributed.nanny.pre-spawn-environ", {}))
-    pre_spawn[ENV_VAR] = tuned_tunables(os.environ.get(ENV_VAR))
-    with dask.config.set(
-        {
-            "distributed.scheduler.allowed-failures": 1,
-            "distributed.nanny.pre-spawn-environ": pre_spawn,
-        }
-    ):
+    # The runs' own processes get the scans' allocator (execute_run_in_child);
+    # the workers only dispatch. A bad VIC_DRAKE_ALLOCATOR fails here, first.
+    try:
+        tuned_environment(os.environ)
+    except ValueError as exc:
+        raise VicDrakeError(str(exc)) from None
+    with dask.config.set({"distributed.scheduler.allowed-failures": 1}):
         cluster = LocalCluster(
             n_workers=n,
             threads_per_worker=1,

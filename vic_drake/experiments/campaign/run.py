@@ -22,6 +22,7 @@ import pandas as pd
 from vic_drake.analysis.contact import contact_loss_intervals, scan_window
 from vic_drake.analysis.scan_metrics import tank_min_J
 from vic_drake.experiments.campaign.plan import RunPlan
+from vic_drake.malloc_tuning import tuned_environment
 from vic_drake.scenario import dumps_scenario
 
 #: The columns whose non-finite values make a run a NaN run.
@@ -121,11 +122,18 @@ def execute_run_in_child(plan: RunPlan) -> dict:
     becomes an error row, and the worker goes on.
     """
     t0 = time.perf_counter()
+    try:
+        env = tuned_environment()
+    except ValueError as exc:  # VIC_DRAKE_ALLOCATOR on this worker's machine.
+        return failed_row(plan, str(exc), wall_s=0.0)
     proc = subprocess.run(
         [sys.executable, "-m", "vic_drake.experiments.campaign.child"],
         input=pickle.dumps(plan),
         capture_output=True,
         check=False,
+        # The allocator of the processes that run scans (mimalloc where
+        # installed): vic_drake.malloc_tuning.
+        env=env,
     )
     if proc.returncode == 0:
         try:
