@@ -45,9 +45,9 @@ def test_no_variation_builds_the_same_diagram():
 
 def test_lateral_joints_and_logs_only_with_lateral_breathing():
     def built(s):
-        diagram, loggers = MakeScanDiagram(s)
+        diagram, logs = MakeScanDiagram(s)
         plant = station_plant(diagram.GetSubsystemByName("station"))
-        return plant.num_positions(), "phantom_lateral" in loggers
+        return plant.num_positions(), "phantom_lateral" in logs
 
     s = _short()
     s.variations.motion.breathing.amplitude_m = 0.01

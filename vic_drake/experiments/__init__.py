@@ -1,7 +1,8 @@
 """Builders and runners of the paper's experiments, on Drake.
 
 - :mod:`~vic_drake.experiments.scan_logs`: the signals a scan logs
-  (:data:`LOG_GROUPS`) and the canonical DataFrame (:func:`logs_to_frame`).
+  (:data:`LOG_GROUPS`), their one log (:class:`ScanLogs`) and the canonical
+  DataFrame (:func:`logs_to_frame`).
 - :mod:`~vic_drake.experiments.scan_diagram`: the closed-loop scan diagram
   (:func:`MakeScanDiagram`) and its initial state.
 - :mod:`~vic_drake.experiments.scan_run`: simulating a scan
@@ -73,7 +74,12 @@ from vic_drake.experiments.scan_diagram import (
     load_scenario_phantom,
     set_initial_state,
 )
-from vic_drake.experiments.scan_logs import LOG_GROUPS, LogGroup, logs_to_frame
+from vic_drake.experiments.scan_logs import (
+    LOG_GROUPS,
+    LogGroup,
+    ScanLogs,
+    logs_to_frame,
+)
 from vic_drake.experiments.scan_run import ScanResult, run_scan
 
 __all__ = [
@@ -100,6 +106,7 @@ __all__ = [
     "MakeScanDiagram",
     "MapPipelineResult",
     "PointFit",
+    "ScanLogs",
     "ScanResult",
     "SimulatedPalpation",
     "campaign_lag",

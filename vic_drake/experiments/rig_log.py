@@ -19,7 +19,6 @@ from pathlib import Path
 from typing import NamedTuple
 
 import pandas as pd
-from pydrake.systems.primitives import LogVectorOutput
 
 from vic_drake.analysis.rig_layout import (
     RIG_SIGNALS,
@@ -65,20 +64,20 @@ RIG_GROUPS = (
 )
 
 
-def add_rig_loggers(builder, *, controller, period_s: float) -> dict:
-    """Adds the loggers of :data:`RIG_GROUPS`; returns {group name: VectorLogSink}.
+def rig_log_ports(controller) -> dict:
+    """The output port of each of :data:`RIG_GROUPS`, by group name.
 
     Args:
-        builder: the scan diagram's DiagramBuilder.
         controller: the variable impedance controller (its "tick_record" and
             "contact" outputs are logged).
-        period_s: the loggers' sampling period (the canonical loggers').
+
+    Raises:
+        VicDrakeError: a port's size is not its group's number of columns.
     """
     ports = {
         "rig_tick_record": controller.GetOutputPort("tick_record"),
         "rig_contact": controller.GetOutputPort("contact"),
     }
-    loggers = {}
     for group in RIG_GROUPS:
         port = ports[group.name]
         if port.size() != len(group.columns):
@@ -86,17 +85,21 @@ def add_rig_loggers(builder, *, controller, period_s: float) -> dict:
                 f"rig log group {group.name!r}: its port has {port.size()} elements, "
                 f"the group names {len(group.columns)}"
             )
-        logger = LogVectorOutput(port, builder, period_s)
-        logger.set_name(f"log_{group.name}")
-        loggers[group.name] = logger
-    return loggers
+    return ports
 
 
-def rig_frame(loggers: dict, root_context, n_rows: int) -> pd.DataFrame:
-    """The :data:`RIG_SIGNALS` logged by :func:`add_rig_loggers`, first n_rows samples."""
+def rig_frame(logs, root_context, n_rows: int) -> pd.DataFrame:
+    """The :data:`RIG_SIGNALS` of a scan's logs, first n_rows samples.
+
+    Args:
+        logs: the scan's :class:`~vic_drake.experiments.scan_logs.ScanLogs`
+            (holding :data:`RIG_GROUPS`, whose ports :func:`rig_log_ports` gives).
+        root_context: the scan diagram's root context after the simulation.
+        n_rows: the number of samples kept.
+    """
     data = {}
     for group in RIG_GROUPS:
-        values = loggers[group.name].FindLog(root_context).data()
+        values = logs.rows(group.name, root_context)
         for i, column in enumerate(group.columns):
             if column is not None:
                 data[column] = values[i, :n_rows]
@@ -106,7 +109,7 @@ def rig_frame(loggers: dict, root_context, n_rows: int) -> pd.DataFrame:
 def check_bag_scenario(scenario) -> None:
     """Raises VicDrakeError, before simulating, if a scenario's log cannot be a rig log.
 
-    A rig log has one row per controller tick: the loggers must sample at
+    A rig log has one row per controller tick: the log must sample at
     the controller's period.
     """
     log_s, tick_s = scenario.logging.period_s, scenario.controller.period_s
@@ -165,9 +168,9 @@ def write_scan_bag(result, path: str | os.PathLike) -> Path:
 __all__ = [
     "RIG_GROUPS",
     "RigGroup",
-    "add_rig_loggers",
     "check_bag_scenario",
     "rig_frame",
+    "rig_log_ports",
     "rig_log_rows",
     "write_scan_bag",
 ]

@@ -2,8 +2,10 @@
 
 :func:`MakeScanDiagram` wires the station (UR3e, F/T sensor, probe,
 phantom), the FDCC compliance stage, the variable impedance controller, the
-target and phantom-lift sources, and one ``LogVectorOutput`` per signal group
-of :data:`vic_drake.experiments.scan_logs.LOG_GROUPS`.
+target and phantom-lift sources, and the log of the signal groups of
+:data:`vic_drake.experiments.scan_logs.LOG_GROUPS` and
+:data:`vic_drake.experiments.rig_log.RIG_GROUPS` (one VectorLogSink behind one
+C++ Multiplexer, :func:`vic_drake.experiments.scan_logs.AddScanLogs`).
 
 Signal flow (all vectors in the base frame W)::
 
@@ -20,15 +22,11 @@ from __future__ import annotations
 
 import numpy as np
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
-from pydrake.systems.primitives import (
-    ConstantVectorSource,
-    Demultiplexer,
-    LogVectorOutput,
-)
+from pydrake.systems.primitives import ConstantVectorSource, Demultiplexer
 
 from vic_drake.errors import VicDrakeError
-from vic_drake.experiments.rig_log import add_rig_loggers
-from vic_drake.experiments.scan_logs import log_groups
+from vic_drake.experiments.rig_log import rig_log_ports
+from vic_drake.experiments.scan_logs import AddScanLogs, log_group_ports
 from vic_drake.experiments.scan_variations import (
     add_sensor_faults,
     controller_map,
@@ -145,8 +143,9 @@ def MakeScanDiagram(
         data_dir: data folder for the measured map (default: vic_drake.paths).
 
     Returns:
-        (diagram, loggers): the Diagram named "scan" and a dict
-        {group name: VectorLogSink} of :data:`LOG_GROUPS` (and
+        (diagram, logs): the Diagram named "scan" and its
+        :class:`~vic_drake.experiments.scan_logs.ScanLogs`, logging every
+        ``scenario.logging.period_s`` the groups of :data:`LOG_GROUPS` (and
         :data:`LATERAL_LOG_GROUP` when the phantom moves laterally) and of
         :data:`vic_drake.experiments.rig_log.RIG_GROUPS`.
     """
@@ -258,27 +257,14 @@ def MakeScanDiagram(
     sources = {
         system.get_name(): system for system in (station, controller, fdcc, target)
     }
-    loggers = {}
-    for group in log_groups(lateral):
-        port = sources[group.source].GetOutputPort(group.port)
-        if port.size() != len(group.fields):
-            raise VicDrakeError(
-                f"log group {group.name!r}: port {group.source}.{group.port} has "
-                f"{port.size()} elements, the group names {len(group.fields)}"
-            )
-        logger = LogVectorOutput(port, builder, scenario.logging.period_s)
-        logger.set_name(f"log_{group.name}")
-        loggers[group.name] = logger
-    loggers.update(
-        add_rig_loggers(
-            builder,
-            controller=controller,
-            period_s=scenario.logging.period_s,
-        )
+    logs = AddScanLogs(
+        builder,
+        {**log_group_ports(sources, lateral=lateral), **rig_log_ports(controller)},
+        period_s=scenario.logging.period_s,
     )
     diagram = builder.Build()
     diagram.set_name("scan")
-    return diagram, loggers
+    return diagram, logs
 
 
 def initial_joint_positions(scenario: Scenario) -> np.ndarray:

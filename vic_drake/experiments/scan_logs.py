@@ -5,6 +5,11 @@ of that port's elements (its layout, as the system documents it) and, by
 element name, the canonical column each kept element fills (the columns of
 :data:`vic_drake.analysis.columns.CANONICAL_COLUMNS`, a contract). Elements not
 listed in ``columns`` are logged but not kept.
+
+:func:`AddScanLogs` records every group (these and the rig's,
+:mod:`vic_drake.experiments.rig_log`) with one VectorLogSink behind one C++
+Multiplexer; the :class:`ScanLogs` it returns reads each group's rows back by
+name.
 """
 
 from __future__ import annotations
@@ -12,7 +17,9 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import NamedTuple
 
+import numpy as np
 import pandas as pd
+from pydrake.systems.primitives import LogVectorOutput, Multiplexer
 
 from vic_drake.analysis.columns import CANONICAL_COLUMNS
 from vic_drake.errors import VicDrakeError
@@ -163,28 +170,107 @@ def log_groups(lateral: bool) -> tuple[LogGroup, ...]:
     return (*LOG_GROUPS, LATERAL_LOG_GROUP) if lateral else LOG_GROUPS
 
 
-def logs_to_frame(loggers: dict, root_context) -> pd.DataFrame:
-    """The loggers' records as one DataFrame of the canonical columns.
+def log_group_ports(systems: Mapping, *, lateral: bool) -> dict:
+    """The output port of each of ``log_groups(lateral)``, by group name.
 
     Args:
-        loggers: {group name: VectorLogSink} of :data:`LOG_GROUPS` (and of
+        systems: {name: system} of the scan diagram's subsystems that own
+            the groups' ports (each group's ``source``).
+        lateral: whether the lateral group is logged.
+
+    Raises:
+        VicDrakeError: a port's size is not its group's number of fields.
+    """
+    ports = {}
+    for group in log_groups(lateral):
+        port = systems[group.source].GetOutputPort(group.port)
+        if port.size() != len(group.fields):
+            raise VicDrakeError(
+                f"log group {group.name!r}: port {group.source}.{group.port} has "
+                f"{port.size()} elements, the group names {len(group.fields)}"
+            )
+        ports[group.name] = port
+    return ports
+
+
+class ScanLogs:
+    """The scan's log groups, recorded by one VectorLogSink.
+
+    The sink records the groups' ports stacked in one vector (see
+    :func:`AddScanLogs`); each group's rows are its slice of the sink's.
+
+    Attributes:
+        sink: the VectorLogSink.
+    """
+
+    def __init__(self, sink, slices: Mapping[str, slice]):
+        self.sink = sink
+        self._slices = dict(slices)
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The logged groups' names, in the sink's order."""
+        return tuple(self._slices)
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._slices
+
+    def times(self, root_context) -> np.ndarray:
+        """The sample times, s (read-only view of the log)."""
+        return self.sink.FindLog(root_context).sample_times()
+
+    def rows(self, name: str, root_context) -> np.ndarray:
+        """Group ``name``'s samples, (its port's elements, samples).
+
+        A read-only view of the log recorded in ``root_context`` (the scan
+        diagram's root context after the simulation).
+        """
+        if name not in self._slices:
+            raise VicDrakeError(
+                f"no log group {name!r}; the scan logs {list(self._slices)}"
+            )
+        return self.sink.FindLog(root_context).data()[self._slices[name]]
+
+
+def AddScanLogs(builder, ports: Mapping, *, period_s: float) -> ScanLogs:
+    """Logs ``ports`` through one C++ Multiplexer ("scan_log_inputs") and one
+    VectorLogSink ("scan_log"): one publish event per sample for all of them.
+
+    Args:
+        builder: the scan diagram's DiagramBuilder.
+        ports: {group name: output port}, in the order they are stacked.
+        period_s: the sink's sampling period, s (``scenario.logging.period_s``).
+    """
+    sizes = [port.size() for port in ports.values()]
+    mux = builder.AddNamedSystem("scan_log_inputs", Multiplexer(sizes))
+    for i, port in enumerate(ports.values()):
+        builder.Connect(port, mux.get_input_port(i))
+    sink = LogVectorOutput(mux.get_output_port(0), builder, period_s)
+    sink.set_name("scan_log")
+    ends = np.cumsum(sizes).tolist()
+    starts = [0, *ends[:-1]]
+    return ScanLogs(
+        sink,
+        {name: slice(a, b) for name, a, b in zip(ports, starts, ends, strict=True)},
+    )
+
+
+def logs_to_frame(logs: ScanLogs, root_context) -> pd.DataFrame:
+    """The logs as one DataFrame of the canonical columns.
+
+    Args:
+        logs: the scan's :class:`ScanLogs` (holding :data:`LOG_GROUPS`, and
             :data:`LATERAL_LOG_GROUP`, whose :data:`LATERAL_COLUMNS` then
             follow the canonical ones).
         root_context: the scan diagram's root context after the simulation.
     """
-    lateral = LATERAL_LOG_GROUP.name in loggers
-    data = {}
-    t = None
+    lateral = LATERAL_LOG_GROUP.name in logs
+    data = {"t_s": logs.times(root_context).copy()}
     for group in log_groups(lateral):
-        log = loggers[group.name].FindLog(root_context)
-        if t is None:
-            t = log.sample_times().copy()
-        values = log.data()
-        n = min(values.shape[1], len(t))
+        values = logs.rows(group.name, root_context)
         for i, column in group.kept():
-            data[column] = values[i, :n]
-    n = min(len(v) for v in data.values())
-    df = pd.DataFrame({"t_s": t[:n], **{k: v[:n] for k, v in data.items()}})
+            data[column] = values[i]
+    df = pd.DataFrame(data)
     return df[list(CANONICAL_COLUMNS) + (list(LATERAL_COLUMNS) if lateral else [])]
 
 
@@ -194,7 +280,10 @@ __all__ = [
     "LATERAL_LOG_GROUP",
     "LOG_GROUPS",
     "XYZ",
+    "AddScanLogs",
     "LogGroup",
+    "ScanLogs",
+    "log_group_ports",
     "log_groups",
     "logs_to_frame",
 ]

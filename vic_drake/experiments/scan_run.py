@@ -89,7 +89,7 @@ def run_scan(
     t_build = time.perf_counter()
     if phantom is None:
         phantom = load_scenario_phantom(scenario, data_dir=data_dir)
-    diagram, loggers = MakeScanDiagram(
+    diagram, logs = MakeScanDiagram(
         scenario,
         phantom=phantom,
         meshcat=meshcat,
@@ -118,9 +118,9 @@ def run_scan(
             )
     wall = time.perf_counter() - t0
     cpu = time.process_time() - c0
-    df = logs_to_frame(loggers, context)
+    df = logs_to_frame(logs, context)
     df.attrs.update(source="sim", scenario=scenario.name)
-    rig = rig_frame(loggers, context, len(df))
+    rig = rig_frame(logs, context, len(df))
     rig.attrs["beta"] = float(phantom.beta)
     return ScanResult(
         df=df,
