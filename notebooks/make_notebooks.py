@@ -377,6 +377,11 @@ def main() -> None:
     out.mkdir(parents=True, exist_ok=True)
     for name, cells in NOTEBOOKS.items():
         nb = new_notebook(cells=cells())
+        # Cell ids from the notebook's name and the cell's place, not random:
+        # regenerating an unchanged notebook leaves the file unchanged.
+        stem = Path(name).stem.split("_", 1)[0]
+        for i, cell in enumerate(nb.cells):
+            cell["id"] = f"nb{stem}-{i:02d}"
         nb.metadata["kernelspec"] = {
             "name": "python3",
             "display_name": "Python 3",
