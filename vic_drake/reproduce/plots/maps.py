@@ -13,6 +13,7 @@ import numpy as np
 from matplotlib import cm, colormaps
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 
 from vic_drake.estimation.gp_maps import TissueMap
 from vic_drake.reproduce.plots.figure import new_figure
@@ -50,6 +51,8 @@ def _panel(
         ax.plot(100 * ok["x_m"], 100 * ok["y_m"], "k.", ms=1.5, alpha=0.5)
     ax.set_xlabel("x [cm]")
     ax.set_ylabel("y [cm]")
+    # A wide map in a narrow panel: few enough x ticks that labels never meet.
+    ax.xaxis.set_major_locator(MaxNLocator(nbins=5))
     fig.colorbar(image, ax=ax, label=label, shrink=0.85)
     return image
 

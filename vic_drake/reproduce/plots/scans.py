@@ -76,7 +76,11 @@ def _flat_note(ax, row: str, sim: pd.DataFrame, name: str) -> None:
     col, text = _MAYBE_FLAT[row]
     if _has(sim, col):
         v = sim[col].to_numpy(float)
-        note = text.format(v=float(v[np.isfinite(v)][0]))
+        value = float(v[np.isfinite(v)][0])
+        if row == "stiffness" and value == 0.0:
+            note = "no stiffness (force control)"
+        else:
+            note = text.format(v=value)
     else:
         note = f"no {col} in this log"
     ax.set_axis_off()
@@ -228,6 +232,33 @@ def plot_fig6(
     return _finish(fig, save_path)
 
 
+def _real_disturbed(ax, real: pd.DataFrame | None, name: str) -> None:
+    """The paper's own disturbed log on its own time axis: the phantom was
+    moved by hand there, not by the simulated lift, so it is not overlaid."""
+    if real is None:
+        ax.set_axis_off()
+        ax.text(
+            0.5,
+            0.5,
+            f"{name.upper()}: no real log",
+            ha="center",
+            va="center",
+            transform=ax.transAxes,
+        )
+        return
+    t = _col(real, "t_s")
+    ax.plot(t, -_col(real, "force_sensor_z_N"), label="F real", **_REAL)
+    ax.set_ylabel("pressing force (N)")
+    ax.set_xlabel("time in the real log (s)")
+    ax.set_title(f"the paper's {name.upper()} log: phantom moved by hand", fontsize=9)
+    twin = ax.twinx()
+    twin.plot(t, 1e3 * _col(real, "z_m"), color="tab:brown", lw=0.8, label="z real")
+    twin.set_ylabel("height (mm)")
+    lines = ax.get_lines() + twin.get_lines()
+    ax.legend(lines, [line.get_label() for line in lines], fontsize=7, loc="best")
+    ax.grid(True, alpha=0.3)
+
+
 def plot_fig7(
     sims: Mapping[str, pd.DataFrame],
     reals: Mapping[str, pd.DataFrame] | None = None,
@@ -237,25 +268,30 @@ def plot_fig7(
     """Fig. 7: the phantom lifted during the scan (VS-VF, CS, CF): force,
     tip height with the lifted surface, K_z, one column per controller.
 
+    The paper's ``_dist`` logs, when given, get a row of their own below:
+    their phantom was moved by hand, differently from the simulated lift
+    (``vic-drake compare-real`` replays a log's own motion).
+
     Args:
         sims: {"vs-vf": df, "cs": df, "cf": df} (any subset, >= 1).
         reals: same keys, real ``_dist`` logs in the canonical layout (optional).
     """
     if not sims:
         raise VicDrakeError("plot_fig7 needs at least one simulated scan")
-    reals = reals or {}
-    rows = _rows_with_information(("force", "height", "stiffness"), sims, reals)
-    fig = new_figure(figsize=(5.0 * len(sims), 2.35 * len(rows)))
-    axes = fig.subplots(len(rows), len(sims), sharex="col", squeeze=False)
+    reals = {k: v for k, v in (reals or {}).items() if v is not None}
+    rows = _rows_with_information(("force", "height", "stiffness"), sims, {})
+    n_rows = len(rows) + bool(reals)
+    fig = new_figure(figsize=(5.0 * len(sims), 2.35 * n_rows))
+    axes = fig.subplots(n_rows, len(sims), squeeze=False)
     for j, (name, sim) in enumerate(sims.items()):
+        sim_axes = axes[: len(rows), j]
+        for ax in sim_axes[1:]:
+            ax.sharex(sim_axes[0])
         _scan_column(
-            axes[:, j],
-            sim,
-            reals.get(name),
-            f"Fig. 7: {name.upper()} disturbed",
-            rows,
-            name,
+            sim_axes, sim, None, f"Fig. 7: {name.upper()} disturbed", rows, name
         )
+        if reals:
+            _real_disturbed(axes[-1, j], reals.get(name), name)
     return _finish(fig, save_path)
 
 

@@ -46,6 +46,8 @@ def offline_fits(ctx: RunContext, logs: dict, label: str) -> dict:
     }
     residuals = claims_mod.ModelResiduals(kv, hc)
     paper = paper_table_i()
+    # Columns in the paper's order (beta descending), as the figure's bars.
+    betas = sorted(TABLE_I_BETAS, reverse=True)
     rows = []
     for name, c in comparisons.items():
         rows.append(
@@ -53,17 +55,17 @@ def offline_fits(ctx: RunContext, logs: dict, label: str) -> dict:
                 name,
                 c.lag_s * 1e3,
                 c.kelvin_voigt.relative,
-                *(c.hunt_crossley[b].relative for b in TABLE_I_BETAS),
+                *(c.hunt_crossley[b].relative for b in betas),
                 c.best_beta,
             ]
         )
-    rows.append(["mean", None, kv, *(hc[b] for b in TABLE_I_BETAS), None])
+    rows.append(["mean", None, kv, *(hc[b] for b in betas), None])
     rows.append(
         [
             "paper",
             None,
             paper["kelvin_voigt"],
-            *(paper[f"hc_{b:g}"] for b in TABLE_I_BETAS),
+            *(paper[f"hc_{b:g}"] for b in betas),
             BEST_BETA,
         ]
     )
@@ -74,7 +76,7 @@ def offline_fits(ctx: RunContext, logs: dict, label: str) -> dict:
                 "log",
                 "lag [ms]",
                 "Kelvin-Voigt",
-                *(f"HC beta={b:g}" for b in TABLE_I_BETAS),
+                *(f"HC beta={b:g}" for b in betas),
                 "best beta (sweep)",
             ],
             rows,

@@ -228,7 +228,10 @@ def _scan_figures(ctx: RunContext, frames: dict) -> None:
             "Phantom lifted and dropped during the scan: force, tip height with "
             "the moving surface, K_z"
             + (
-                " (grey: the real _dist logs of CS and CF)."
+                ". Last row: the paper's _dist logs of CS and CF, on their own "
+                "time axis (their phantom was moved by hand, not by the "
+                "simulated lift; vic-drake compare-real replays a log's own "
+                "motion)."
                 if real.get("disturbance")
                 else "; no real logs in this run."
             ),
