@@ -24,7 +24,10 @@ def test_compare_real_rejects_a_bad_surface_offset_before_reading_the_bag(
 ):
     assert main(["compare-real", str(tmp_path), "--surface-offset", value]) == 2
     err = capsys.readouterr().err
-    assert "--surface-offset takes none or auto or a number of mm" in err
+    assert (
+        "--surface-offset takes none or auto or anchors or placement or a number "
+        "of mm" in err
+    )
     assert "Traceback" not in err
 
 

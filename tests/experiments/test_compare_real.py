@@ -67,9 +67,15 @@ def test_compare_real_reports_the_motion_and_contact_loss(
     moved = sim["phantom_lift_m"].abs().max()
     assert bool(moved > 1e-4) is replayed
     assert ("lift_max_mm" in out) is replayed
-    # A 9-column log holds no evidence of its own: the rig default applies.
-    assert out["surface_offset_mm"] == pytest.approx(1e3 * RIG_SURFACE_OFFSET_M)
-    assert out["surface_offset_source"] == "rig default"
+    # A 9-column log holds no anchor of its own: a moving phantom gets the
+    # rig default, a resting one the plane of its in-contact surface.
+    if replayed:
+        assert out["surface_offset_mm"] == pytest.approx(1e3 * RIG_SURFACE_OFFSET_M)
+        assert out["surface_offset_source"] == "rig default"
+    else:
+        assert out["surface_offset_source"] == "placement"
+        assert out["surface_offset_mm"] == out["surface_placement_offset_mm"]
+    assert out["surface_placement_slope_mm_per_m"] is not None
     assert out["surface_first_contact_mm"] is None
     assert out["controller_map_offset_mm"] is None
 
@@ -122,12 +128,11 @@ def test_compare_real_simulates_the_given_relaxation(data_dir):
 
     bag = data_dir / "experiments" / "test_force_control"
     rel = RelaxationParams((0.3,), (0.5,))
-    out, sim, _ = compare_real(
-        bag, data_dir=data_dir, duration_s=2.5, relaxation=rel, return_frames=True
-    )
-    base, sim0, _ = compare_real(
-        bag, data_dir=data_dir, duration_s=2.5, return_frames=True
-    )
+    # One surface for both ("auto" would read each run's plane with its own
+    # law, placing the tissue where the log's tip height says).
+    kw = dict(data_dir=data_dir, duration_s=2.5, surface_offset="anchors")
+    out, sim, _ = compare_real(bag, relaxation=rel, return_frames=True, **kw)
+    base, sim0, _ = compare_real(bag, return_frames=True, **kw)
     assert out["tissue_relaxation"] == {"fractions": [0.3], "time_constants_s": [0.5]}
     assert "tissue_relaxation" not in base
     assert out["tissue_law"] == base["tissue_law"] == "relaxing"

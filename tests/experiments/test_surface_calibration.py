@@ -25,7 +25,8 @@ SCAN_LOGS = ("test_compliance_control400", "test_force_control")
 
 def test_parse_surface_offset():
     assert parse_surface_offset(None) == DEFAULT_SURFACE_OFFSET == "auto"
-    assert parse_surface_offset("auto") == "auto"
+    for mode in ("auto", "anchors", "placement", "none"):
+        assert parse_surface_offset(mode) == mode
     assert parse_surface_offset(-0.002) == -0.002
     for bad in ("rig", 0.05, float("nan"), "3"):
         with pytest.raises(VicDrakeError, match="surface offset"):
@@ -136,7 +137,7 @@ def test_auto_falls_back_on_the_rig_default_for_a_loose_first_contact(
     far = first._replace(offset_m=2 * calibration.MAX_SURFACE_OFFSET_M)
     for bad in (loose, far):
         monkeypatch.setattr(calibration, "first_contact_offset", lambda *a, b=bad: b)
-        surface = calibration.surface_calibration(real, phantom, "auto")
+        surface = calibration.surface_calibration(real, phantom, "anchors")
         assert surface["source"] == "rig default"
         assert surface["offset_m"] == RIG_SURFACE_OFFSET_M
         assert surface["first_contact"] is bad  # still reported
@@ -169,7 +170,7 @@ def test_auto_profile_between_two_plausible_anchors_and_its_fallbacks(
 
     def use(lift_off):
         monkeypatch.setattr(calibration, "lift_off_offset", lambda *a, **k: lift_off)
-        return calibration.surface_calibration(real, phantom, "auto")
+        return calibration.surface_calibration(real, phantom, "anchors")
 
     surface = use(lift)
     assert surface["source"] == "first contact + lift-off"
@@ -210,13 +211,13 @@ def test_the_real_lift_offs_are_not_used(data_dir):
     phantom = load_phantom("measured", data_dir=data_dir, lookup="bilinear")
     for name in VS_LOGS:
         real = real_to_canonical(read_bag(data_dir / "experiments" / name))
-        surface = surface_calibration(real, phantom, "auto")
+        surface = surface_calibration(real, phantom, "anchors")
         assert surface["lift_off"] is not None
         assert surface["lift_off"].kappa_scale > 1.8
         assert surface["source"] == "first contact" and surface["profile"] is None
     for name in SCAN_LOGS:
         real = real_to_canonical(read_bag(data_dir / "experiments" / name))
-        assert surface_calibration(real, phantom, "auto")["lift_off"] is None
+        assert surface_calibration(real, phantom, "anchors")["lift_off"] is None
 
 
 @pytest.mark.realdata
@@ -238,7 +239,7 @@ def test_compare_real_with_a_profile_raises_the_tissue_not_the_controllers_map(
 
     monkeypatch.setattr(module, "run_scan", build_only)
     with pytest.raises(_Built):
-        compare_real(bag, data_dir=data_dir)
+        compare_real(bag, data_dir=data_dir, surface_offset="anchors")
     x, y = np.array([-0.155, lift.x_m, -0.05, first.x_m, 0.04]), np.full(5, -0.356)
     raised = built["phantom"].surface_z(x, y) - published.surface_z(x, y)
     expected = [lift.offset_m, lift.offset_m, None, first.offset_m, first.offset_m]
@@ -297,3 +298,155 @@ def test_a_simulated_lift_off_reads_the_known_surface(data_dir):
     assert found.kappa_scale == pytest.approx(1.0, abs=0.1)
     plain = lift_off_offset(sim, published, viscous=False)
     assert abs(1e3 * plain.offset_m - 3.0) > 0.3
+
+
+def _flat_grid():
+    from vic_drake.tissue.phantom import GridPhantom
+
+    xs, ys = np.linspace(-0.2, 0.1, 31), np.linspace(-0.4, -0.3, 11)
+    return GridPhantom(
+        x_m=xs, y_m=ys, z_m=np.full((31, 11), 0.1), kappa=np.full((31, 11), 3e3),
+        lam=np.full((31, 11), 3e4), surface_offset_m=0.0025,
+    )  # fmt: skip
+
+
+def test_surface_plane_raises_a_grid_by_a_plane():
+    from vic_drake.tissue.phantom.distorted import with_surface_plane
+
+    flat = _flat_grid()
+    placed = with_surface_plane(flat, 0.002, (-0.02, 0.01), (-0.05, -0.35))
+    x = np.array([-0.2, -0.15, -0.05, 0.0, 0.1])
+    for y in (-0.38, -0.35):
+        np.testing.assert_allclose(
+            placed.surface_z(x, y) - flat.surface_z(x, y),
+            0.002 - 0.02 * (x + 0.05) + 0.01 * (y + 0.35),
+            atol=1e-12,
+        )
+    np.testing.assert_allclose(placed.surface_gradient(-0.07, -0.36), (-0.02, 0.01))
+    np.testing.assert_allclose(placed.kappa(x, -0.35), flat.kappa(x, -0.35))
+    assert placed.lookup == flat.lookup
+    for bad in (
+        (np.nan, (0.0, 0.0), (0.0, 0.0)),
+        (0.0, (0.0,), (0.0, 0.0)),
+        (0.0, (0.0, 0.0), (0.0, np.inf)),
+    ):
+        with pytest.raises(VicDrakeError, match="surface plane"):
+            with_surface_plane(flat, *bad)
+    with pytest.raises(VicDrakeError, match="grid phantom"):
+        with_surface_plane(object(), 0.0, (0.0, 0.0), (0.0, 0.0))
+
+
+def _placement(offset_m=0.002, slope=0.015, span_m=0.18):
+    from vic_drake.analysis.surface_placement import SurfacePlacement
+
+    return SurfacePlacement(
+        offset_m=offset_m, slope_m_per_m=slope, offset_sigma_m=1e-4,
+        slope_sigma_m=2e-3, x0_m=-0.05, y0_m=-0.355, direction=(0.8, -0.6),
+        span_m=span_m, bins=19, samples=9000, residual_rms_m=5e-4,
+    )  # fmt: skip
+
+
+def test_placed_surface_applies_the_plane_only_to_a_resting_phantom():
+    from vic_drake.experiments.surface_calibration import placed_surface
+
+    anchors = {
+        "offset_m": 0.004, "source": "first contact", "profile": None,
+        "plane": None, "placement": _placement(), "placement_wanted": True,
+    }  # fmt: skip
+    placed = placed_surface(anchors, resting=True)
+    assert placed["source"] == "placement" and placed["offset_m"] == 0.002
+    assert placed["plane"]["origin_m"] == (-0.05, -0.355)
+    np.testing.assert_allclose(placed["plane"]["gradient"], (0.012, -0.009))
+    assert anchors["source"] == "first contact"  # not changed in place
+    # A moving phantom, a mode that does not ask for it, no plane, or a plane
+    # that leaves the map's +-20 mm at an end of its span: the anchors.
+    too_steep = _placement(slope=2 * calibration_max() / 0.18 + 0.01)
+    for surface, resting in (
+        (anchors, False),
+        ({**anchors, "placement_wanted": False}, True),
+        ({**anchors, "placement": None}, True),
+        ({**anchors, "placement": too_steep}, True),
+        ({**anchors, "placement": _placement(offset_m=0.025)}, True),
+    ):
+        assert placed_surface(surface, resting=resting) is surface
+
+
+def calibration_max():
+    from vic_drake.experiments.surface_calibration import MAX_SURFACE_OFFSET_M
+
+    return MAX_SURFACE_OFFSET_M
+
+
+def test_surface_calibration_reads_the_plane_and_leaves_it_to_placed_surface():
+    """On a synthetic log: the plane is reported under every mode, and
+    wanted only under "auto" and "placement"."""
+    from tests.analysis.test_surface_placement import _map, _scan
+
+    phantom = _map()
+    scan = _scan(phantom, 0.003, 0.01)
+    for mode, wanted in (
+        ("auto", True), ("placement", True), ("anchors", False), ("none", False),
+        (0.001, False),
+    ):  # fmt: skip
+        surface = surface_calibration(scan, phantom, mode)
+        assert surface["placement_wanted"] is wanted
+        assert surface["plane"] is None
+        assert 1e3 * surface["placement"].slope_m_per_m == pytest.approx(10.0, abs=0.3)
+
+
+@pytest.mark.realdata
+def test_compare_real_places_a_resting_phantom_and_keeps_the_controllers_map(
+    data_dir, monkeypatch
+):
+    module = importlib.import_module("vic_drake.experiments.compare_real")
+    published = load_phantom("measured", data_dir=data_dir, lookup="bilinear")
+    built = {}
+
+    def build_only(scenario, *, phantom, controller_phantom=None, **_):
+        built.update(scenario=scenario, phantom=phantom, ctrl=controller_phantom)
+        raise _Built
+
+    monkeypatch.setattr(module, "run_scan", build_only)
+    bag = data_dir / "experiments" / "test_nardi_matForce_lowR"
+    with pytest.raises(_Built):
+        compare_real(bag, data_dir=data_dir)
+    real = real_to_canonical(read_bag(bag))
+    plane = surface_calibration(real, published)["placement"]
+    x, y = np.linspace(-0.15, 0.04, 20), np.full(20, -0.356)
+    raised = built["phantom"].surface_z(x, y) - published.surface_z(x, y)
+    np.testing.assert_allclose(raised, plane.offset_at(x, y), atol=2e-5)
+    assert built["scenario"].variations.map_errors.surface_offset_m == 0.0
+    seen = controller_map(built["scenario"], built["ctrl"])
+    np.testing.assert_allclose(
+        seen.surface_z(x, y), published.surface_z(x, y), atol=1e-12
+    )
+    # A log whose phantom moves keeps the anchors' constant (the rig default).
+    built.clear()
+    with pytest.raises(_Built):
+        compare_real(data_dir / "experiments" / "test_force_control_dist")
+    raised = built["phantom"].surface_z(x, y) - published.surface_z(x, y)
+    np.testing.assert_allclose(raised, RIG_SURFACE_OFFSET_M, atol=1e-12)
+    assert built["ctrl"] is None
+
+
+@pytest.mark.realdata
+def test_the_real_placements(data_dir):
+    """nardi's phantom is tilted along the track by more than 5 sigma of its
+    plane; tracking5's is not; the two 9-column logs of one session, six
+    minutes apart under different controllers, read one plane."""
+    phantom = load_phantom("measured", data_dir=data_dir, lookup="bilinear")
+
+    def plane(name):
+        real = real_to_canonical(read_bag(data_dir / "experiments" / name))
+        return surface_calibration(real, phantom)["placement"]
+
+    nardi, tracking = plane("test_nardi_matForce_lowR"), plane("test_tracking5")
+    assert nardi.slope_m_per_m > 5 * nardi.slope_sigma_m
+    assert 1e3 * nardi.slope_m_per_m == pytest.approx(16.6, abs=0.2)
+    assert abs(tracking.slope_m_per_m) < 2 * tracking.slope_sigma_m
+    cs, cf = plane(SCAN_LOGS[0]), plane(SCAN_LOGS[1])
+    at = (-0.055, -0.355)
+    assert cs.offset_at(*at) == pytest.approx(cf.offset_at(*at), abs=1e-4)
+    assert abs(cs.slope_m_per_m - cf.slope_m_per_m) < np.hypot(
+        cs.slope_sigma_m, cf.slope_sigma_m
+    )

@@ -54,7 +54,7 @@ def _count(value: str) -> int | str:
 
 
 def _surface_offset(value: str):
-    """--surface-offset: "auto", "none" or a number of mm (returned in m)."""
+    """--surface-offset: one of SURFACE_OFFSET_MODES or a number of mm (returned in m)."""
     from vic_drake.experiments.surface_calibration import (
         MAX_SURFACE_OFFSET_M,
         SURFACE_OFFSET_MODES,
@@ -144,13 +144,15 @@ def register(subparsers) -> None:
     )
     p.add_argument(
         "--surface-offset",
-        metavar="MM|auto|none",
+        metavar="MM|auto|placement|anchors|none",
         default=None,
-        help="raise the simulated tissue above the published map: a number of mm, "
-        "'auto' (the default: the log's first contact from free space and its "
-        "final lift-off, a profile along x when both are plausible, else the one "
-        "that is, else the rig's default) or 'none'; the controller keeps reading "
-        "the published map",
+        help="raise the simulated tissue above the published map: a number of mm; "
+        "'placement' (the plane of the log's in-contact surface, offset and tilt "
+        "along the track, when the phantom rests, else the anchors); 'anchors' "
+        "(the log's first contact from free space and its final lift-off, a "
+        "profile along x when both are plausible, else the one that is, else the "
+        "rig's default); 'auto' (the default: placement); or 'none'; the "
+        "controller keeps reading the published map",
     )
     p.add_argument(
         "--lateral-passes",

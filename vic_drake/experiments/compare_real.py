@@ -41,6 +41,7 @@ from vic_drake.experiments.real_logs import (
 from vic_drake.experiments.scan_run import run_scan
 from vic_drake.experiments.surface_calibration import (
     parse_surface_offset,
+    placed_surface,
     surface_calibration,
 )
 from vic_drake.realdata import read_bag
@@ -48,7 +49,11 @@ from vic_drake.scenario import DisturbanceConfig, TrajectoryConfig
 from vic_drake.station.params import StationParams
 from vic_drake.tissue import TISSUE_LAWS
 from vic_drake.tissue.phantom import load_phantom
-from vic_drake.tissue.phantom.distorted import with_map_errors, with_surface_profile
+from vic_drake.tissue.phantom.distorted import (
+    with_map_errors,
+    with_surface_plane,
+    with_surface_profile,
+)
 from vic_drake.tissue.relaxation import RelaxationParams, tissue_relaxation
 
 
@@ -109,9 +114,12 @@ def compare_real(
     contact losses of both runs are compared.
     Alignment: :func:`vic_drake.analysis.real_comparison.compare_with_real`.
     ``surface_offset`` raises the simulated tissue above the published map:
-    a number of m, "auto" or "none", None for
+    a number of m, "auto", "placement", "anchors" or "none", None for
     :data:`~vic_drake.experiments.surface_calibration.DEFAULT_SURFACE_OFFSET`
-    (:func:`~vic_drake.experiments.surface_calibration.surface_calibration`);
+    (:func:`~vic_drake.experiments.surface_calibration.surface_calibration`;
+    "placement", auto's mode, places the published map by the plane of the
+    log's in-contact surface when the motion is not replayed,
+    :func:`~vic_drake.experiments.surface_calibration.placed_surface`);
     the controller keeps reading the published map.
     ``lateral_passes`` (0 to 3, or "auto", the default: one when the motion
     is replayed, else none) reruns the scan that many times, each with the
@@ -146,7 +154,13 @@ def compare_real(
         ``surface_profile_offset_mm`` (its two anchors; ``surface_offset_mm``
         is then their mean), else None. ``lateral_passes`` (the number run)
         and ``lateral_rms_mm`` (per run, the RMS horizontal distance between
-        the tips over the real scan window) are appended.
+        the tips over the real scan window) are appended, then the placement
+        plane the log gives (whether applied or not; source "placement" when
+        applied, ``surface_offset_mm`` then its offset at its origin):
+        ``surface_placement_offset_mm`` (``_sigma_mm``),
+        ``surface_placement_slope_mm_per_m`` (``_sigma_mm_per_m``; the rise
+        along ``surface_placement_direction``), ``surface_placement_origin_m``
+        and ``surface_placement_residual_rms_mm`` (None without a plane).
         With ``return_frames``: (dict, sim DataFrame, real canonical DataFrame).
     """
     bag = Path(bag_dir)
@@ -204,6 +218,11 @@ def compare_real(
         phantom = with_surface_profile(published, profile["x_m"], profile["offset_m"])
     motion, table, surface_error = phantom_replay(bag, real, phantom)
     replay = bool(table)
+    # A resting phantom: its placement plane, when the mode asks for it.
+    surface = placed_surface(surface, resting=not replay)
+    plane = surface["plane"]
+    if plane is not None:
+        phantom = with_surface_plane(published, **plane)
     lateral_passes = resolve_lateral_passes(lateral_passes, replayed=replay)
     disturbance = DisturbanceConfig(table=table) if replay else None
     lift_m = motion["phantom_lift_m"].to_numpy()
@@ -237,14 +256,16 @@ def compare_real(
         scenario.station.tissue_law = tissue_law
     if relaxation is not None:
         scenario.station = scenario.station.with_relaxation(relaxation)
-    if surface["offset_m"] != 0.0 and profile is None:
+    if surface["offset_m"] != 0.0 and profile is None and plane is None:
         # The controller reads the published map, as the real one read its own.
         scenario.variations.map_errors.surface_offset_m = -surface["offset_m"]
     if tissue_law is not None or relaxation is not None or surface["offset_m"] != 0.0:
         scenario.validate()
     if progress:
         progress(scenario.description)
-    extra = {} if profile is None else {"controller_phantom": published}
+    extra = (
+        {} if profile is None and plane is None else {"controller_phantom": published}
+    )
     result = run_scan(
         scenario, phantom=phantom, duration_s=duration_s, progress=progress, **extra
     )
@@ -311,6 +332,7 @@ def compare_real(
     out.update(_lift_off_keys(surface["lift_off"], surface["profile"]))
     out["lateral_passes"] = lateral_passes
     out["lateral_rms_mm"] = lateral_rms
+    out.update(_placement_keys(surface["placement"]))
     if relaxation is not None:
         out["tissue_relaxation"] = relaxation.as_dict()
     if return_frames:
@@ -349,6 +371,32 @@ def _lift_off_keys(lift, profile) -> dict:
         None if profile is None else [1e3 * v for v in profile["offset_m"]]
     )
     return out
+
+
+def _placement_keys(placement) -> dict:
+    """compare-real's placement-plane keys (mm, mm/m; None without a plane)."""
+    names = (
+        "offset_mm",
+        "offset_sigma_mm",
+        "slope_mm_per_m",
+        "slope_sigma_mm_per_m",
+        "origin_m",
+        "direction",
+        "residual_rms_mm",
+    )
+    if placement is None:
+        return {f"surface_placement_{k}": None for k in names}
+    p = placement
+    values = (
+        1e3 * p.offset_m,
+        1e3 * p.offset_sigma_m,
+        1e3 * p.slope_m_per_m,
+        1e3 * p.slope_sigma_m,
+        [p.x0_m, p.y0_m],
+        list(p.direction),
+        1e3 * p.residual_rms_m,
+    )
+    return {f"surface_placement_{k}": v for k, v in zip(names, values)}
 
 
 __all__ = ["compare_real", "phantom_replay"]

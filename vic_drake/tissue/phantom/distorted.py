@@ -137,4 +137,59 @@ def with_surface_profile(phantom: Phantom, x_m, offsets_m) -> GridPhantom:
     )
 
 
-__all__ = ["DistortedPhantom", "with_map_errors", "with_surface_profile"]
+def with_surface_plane(
+    phantom: Phantom, offset_m: float, gradient, origin_m
+) -> GridPhantom:
+    """A grid phantom whose surface is raised by a plane: a placement.
+
+    The raise at (x, y) is ``offset_m + gx (x - x0) + gy (y - y0)``,
+    (gx, gy) = ``gradient`` (m/m), (x0, y0) = ``origin_m``, over the whole
+    grid (a phantom put back on the rig higher and tilted: the plane goes on
+    beyond the scan track); kappa, lambda and the lookup are the phantom's,
+    the slopes follow the raised surface.
+
+    Raises:
+        VicDrakeError: not a :class:`GridPhantom`, or the numbers are not
+            finite pairs.
+    """
+    if not isinstance(phantom, GridPhantom):
+        raise VicDrakeError(
+            f"a surface plane needs a grid phantom; got {type(phantom).__name__}"
+        )
+    g, o = np.asarray(gradient, float), np.asarray(origin_m, float)
+    if (
+        g.shape != (2,)
+        or o.shape != (2,)
+        or not np.all(np.isfinite(g))
+        or not np.all(np.isfinite(o))
+        or not np.isfinite(offset_m)
+    ):
+        raise VicDrakeError(
+            "a surface plane needs a finite offset and finite (x, y) pairs for its "
+            f"gradient and origin; got offset_m={offset_m!r}, gradient={gradient!r}, "
+            f"origin_m={origin_m!r}"
+        )
+    raise_xy = (
+        float(offset_m)
+        + g[0] * (phantom.x_m[:, None] - o[0])
+        + g[1] * (phantom.y_m[None, :] - o[1])
+    )
+    return GridPhantom(
+        x_m=phantom.x_m,
+        y_m=phantom.y_m,
+        z_m=phantom.surface_m - phantom.surface_offset_m + raise_xy,
+        kappa=phantom.kappa_grid,
+        lam=phantom.lam_grid,
+        beta=phantom.beta,
+        surface_offset_m=phantom.surface_offset_m,
+        lookup=phantom.lookup,
+        name=f"{phantom.name} (surface plane)",
+    )
+
+
+__all__ = [
+    "DistortedPhantom",
+    "with_map_errors",
+    "with_surface_plane",
+    "with_surface_profile",
+]
