@@ -178,6 +178,44 @@ def test_the_command_line_names_an_unknown_allocator():
     )
 
 
+@pytest.mark.parametrize(
+    "args, first",
+    [
+        (["--help"], "usage: vic-drake [-h]"),
+        (["--version"], "vic-drake "),
+        (["scan", "--help"], "usage: vic-drake scan"),
+        (["map", "-h", "--out", "x"], "usage: vic-drake map"),
+    ],
+)
+def test_help_and_version_print_despite_an_unknown_allocator(args, first):
+    """The allocator matters to the commands, not to their help: it prints,
+    after a note naming the bad value; a command still refuses to run."""
+    env = {**_without_ours(**{ALLOCATOR_VAR: "tcmalloc"}), "PYTHONPATH": str(ROOT)}
+    code = (
+        f"import sys; sys.argv = ['vic-drake', *{args!r}];"
+        "from vic_drake.cli import main; sys.exit(main())"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code], env=env, capture_output=True, text=True
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.startswith(first)
+    assert done.stderr.strip() == (
+        f"vic-drake: note: {ALLOCATOR_VAR}='tcmalloc': choose from mimalloc, glibc "
+        "(commands will not run)"
+    )
+    # After "--", -h is an argument, not a request for help.
+    code = (
+        "import sys; sys.argv = ['vic-drake', 'scan', '--', '-h'];"
+        "from vic_drake.cli import main; sys.exit(main())"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code], env=env, capture_output=True, text=True
+    )
+    assert done.returncode == 2 and "tcmalloc" in done.stderr
+    assert "note:" not in done.stderr
+
+
 def test_the_command_line_called_as_a_function_does_not_restart(capsys):
     from vic_drake.cli import main
 

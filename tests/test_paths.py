@@ -1,11 +1,19 @@
-"""Data and output paths: one error for a bad --data-dir or $VIC_DRAKE_DATA,
+"""Data, input and output paths: one error for a bad --data-dir or $VIC_DRAKE_DATA,
 and output paths checked before any simulation."""
+
+from pathlib import Path
 
 import pytest
 
 from vic_drake.cli import main
 from vic_drake.errors import VicDrakeError
-from vic_drake.paths import check_data_dir, check_output_dir, check_output_file
+from vic_drake.paths import (
+    check_data_dir,
+    check_input_file,
+    check_output_dir,
+    check_output_file,
+    find_bag,
+)
 
 
 def test_bad_env_data_dir_is_the_bad_option_error(tmp_path, monkeypatch, capsys):
@@ -61,3 +69,46 @@ def test_check_output_helpers(tmp_path):
     assert f.parent.is_dir() and not f.exists()
     with pytest.raises(VicDrakeError, match="is a folder"):
         check_output_file(d, "--plot")
+
+
+def test_find_bag_as_given_then_in_the_data_folder(tmp_path, monkeypatch):
+    data = tmp_path / "data"
+    (data / "palpation" / "soft").mkdir(parents=True)
+    here = tmp_path / "here"
+    (here / "palpation" / "soft").mkdir(parents=True)
+    monkeypatch.delenv("VIC_DRAKE_DATA", raising=False)
+    monkeypatch.chdir(here)
+    # The current folder first, then the data folder.
+    assert find_bag("palpation/soft", data) == Path("palpation/soft")
+    monkeypatch.chdir(tmp_path)
+    assert find_bag("palpation/soft", data) == data / "palpation" / "soft"
+    monkeypatch.setenv("VIC_DRAKE_DATA", str(data))
+    assert find_bag("palpation/soft") == data / "palpation" / "soft"
+    assert find_bag(here / "palpation" / "soft") == here / "palpation" / "soft"
+    with pytest.raises(VicDrakeError) as exc:
+        find_bag("palpation/sotf", what="palpation bag", expected="a palpation")
+    assert str(exc.value) == (
+        f"palpation bag 'palpation/sotf' does not exist in the current folder "
+        f"({str(tmp_path)!r}) nor in the data folder {str(data)!r} "
+        "($VIC_DRAKE_DATA) (did you mean 'palpation/soft'?); expected a palpation"
+    )
+    # An absolute path is only itself.
+    with pytest.raises(VicDrakeError, match=r"'/.*sotf' does not exist \(did you"):
+        find_bag(data / "palpation" / "sotf")
+
+
+def test_check_input_file_names_a_folder_and_an_example(tmp_path):
+    (tmp_path / "b.yaml").write_text("")
+    (tmp_path / "a.yaml").write_text("")
+    assert check_input_file(tmp_path / "a.yaml", "scenario file") == tmp_path / "a.yaml"
+    with pytest.raises(VicDrakeError) as exc:
+        check_input_file(tmp_path, "scenario file")
+    assert str(exc.value) == (
+        f"scenario file {str(tmp_path)!r} is a folder; give one of its .yaml files, "
+        f"e.g. {tmp_path / 'a.yaml'}"
+    )
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(VicDrakeError, match="folder .with no .yaml files"):
+        check_input_file(tmp_path / "empty", "scenario file")
+    with pytest.raises(VicDrakeError, match=r"does not exist \(did you mean"):
+        check_input_file(tmp_path / "c.yaml", "scenario file")

@@ -17,7 +17,7 @@ import sys
 from vic_drake import __version__
 from vic_drake.errors import VicDrakeError
 from vic_drake.malloc_tuning import reexec_tuned
-from vic_drake.paths import check_data_dir
+from vic_drake.paths import WITHOUT_DATA_SYNTHETIC, check_data_dir
 
 # Modules under vic_drake.commands, each with register(subparsers).
 COMMAND_MODULES = (
@@ -42,6 +42,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
     subparsers.required = True
+    parser.set_defaults(_subparsers=subparsers)
     for name in COMMAND_MODULES:
         try:
             module = importlib.import_module(f"vic_drake.commands.{name}")
@@ -53,6 +54,44 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def subcommand_parser(
+    parser: argparse.ArgumentParser, name: str
+) -> argparse.ArgumentParser:
+    """The parser of subcommand ``name`` (of :func:`build_parser`'s parser)."""
+    return parser.get_default("_subparsers").choices[name]
+
+
+def _unknown_arguments(parser: argparse.ArgumentParser, args, extras) -> None:
+    """Fails on arguments no option took, with the subcommand's usage and,
+    for a misspelt option, the closest of its options (difflib)."""
+    import difflib
+
+    sub = subcommand_parser(parser, args.command)
+    options = [o for a in sub._actions for o in a.option_strings]
+    hints = []
+    for extra in extras:
+        if extra.startswith("-"):
+            near = difflib.get_close_matches(extra.split("=", 1)[0], options, n=1)
+            if near:
+                hints.append(f"did you mean {near[0]}?")
+    message = f"unrecognized arguments: {' '.join(extras)}"
+    sub.error(f"{message} ({'; '.join(hints)})" if hints else message)
+
+
+#: Arguments that print and exit without running a command.
+_PRINT_ONLY = ("-h", "--help", "--version")
+
+
+def _only_prints(argv: list[str]) -> bool:
+    """Whether the command line asks for help or the version (before any "--")."""
+    for arg in argv:
+        if arg == "--":
+            return False
+        if arg in _PRINT_ONLY:
+            return True
+    return False
+
+
 def main(argv: list[str] | None = None) -> int:
     if argv is None:
         # Run as the program: restart once with the scan processes' allocator
@@ -60,14 +99,23 @@ def main(argv: list[str] | None = None) -> int:
         try:
             reexec_tuned()
         except ValueError as exc:
-            print(f"vic-drake: error: {exc}", file=sys.stderr)
-            return 2
+            # A bad allocator name stops every command, but help and the
+            # version still print (with the error as a note first).
+            if not _only_prints(sys.argv[1:]):
+                print(f"vic-drake: error: {exc}", file=sys.stderr)
+                return 2
+            print(f"vic-drake: note: {exc} (commands will not run)", file=sys.stderr)
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args, extras = parser.parse_known_args(argv)
+    if extras:
+        _unknown_arguments(parser, args, extras)
     try:
         # --data-dir or $VIC_DRAKE_DATA naming a folder without the data is
         # one error for every command, before any work.
-        check_data_dir(getattr(args, "data_dir", None))
+        check_data_dir(
+            getattr(args, "data_dir", None),
+            getattr(args, "without_data", WITHOUT_DATA_SYNTHETIC),
+        )
         return int(args.handler(args) or 0)
     except VicDrakeError as exc:
         print(f"vic-drake: error: {exc}", file=sys.stderr)

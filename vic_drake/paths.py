@@ -40,12 +40,24 @@ def has_data(data_dir: str | os.PathLike | None = None) -> bool:
 _DATA_LAYOUT = "phantom_map/, experiments/, palpation/ and loadcycle/"
 
 
-def check_data_dir(data_dir: str | os.PathLike | None = None) -> None:
+#: What a command does without the data, as :func:`check_data_dir` words it.
+WITHOUT_DATA_SYNTHETIC = "run on the synthetic phantom"
+
+
+def check_data_dir(
+    data_dir: str | os.PathLike | None = None,
+    without: str | None = WITHOUT_DATA_SYNTHETIC,
+) -> None:
     """Fails when the user named a data folder that does not hold the data.
 
     A folder given as ``--data-dir`` or in ``$VIC_DRAKE_DATA`` must hold the
     paper's measurements (both are the same error); only the default
-    ``../shared/data`` may be absent (the run then uses the synthetic phantom).
+    ``../shared/data`` may be absent.
+
+    Args:
+        without: what the command does without a data folder, for the
+            message's "omit the option to ..." (default: it runs on the
+            synthetic phantom); None when it cannot run without the data.
 
     Raises:
         DataNotFoundError: naming the option or variable, the path and the
@@ -63,10 +75,88 @@ def check_data_dir(data_dir: str | os.PathLike | None = None) -> None:
         what = (
             "does not exist" if not path.exists() else "does not hold the paper's data"
         )
-        raise DataNotFoundError(
-            f"{source}: {str(path)!r} {what}; expected {_DATA_LAYOUT} in it ({hint} "
-            "to run on the synthetic phantom)"
+        tail = (
+            f"{hint} to {without}"
+            if without
+            else "this command needs the data: name the folder that holds them"
         )
+        raise DataNotFoundError(
+            f"{source}: {str(path)!r} {what}; expected {_DATA_LAYOUT} in it ({tail})"
+        )
+
+
+def _data_dir_source(data_dir: str | os.PathLike | None) -> str:
+    """Where :func:`resolve_data_dir` took the data folder from, for messages."""
+    if data_dir is not None:
+        return "--data-dir"
+    if os.environ.get(DATA_ENV_VAR):
+        return f"${DATA_ENV_VAR}"
+    return "the default, ../shared/data beside the project"
+
+
+def _close_names(folder: Path, name: str) -> list[str]:
+    """Entries of ``folder`` whose names are close to ``name`` (difflib)."""
+    import difflib
+
+    try:
+        names = sorted(p.name for p in folder.iterdir())
+    except OSError:
+        return []
+    return difflib.get_close_matches(name, names, n=3, cutoff=0.6)
+
+
+def find_bag(
+    text: str | os.PathLike,
+    data_dir: str | os.PathLike | None = None,
+    *,
+    what: str = "bag",
+    expected: str = "a ROS 2 bag folder (metadata.yaml + .db3)",
+) -> Path:
+    """The bag folder (or file) ``text`` names, for every command that reads one.
+
+    ``text`` as given (absolute, or relative to the current folder), else,
+    when relative, relative to the data folder (:func:`resolve_data_dir` of
+    ``data_dir``: ``--data-dir``, ``$VIC_DRAKE_DATA``, ``../shared/data``),
+    so ``palpation/test_soft_1hz`` names the paper's log from any folder.
+
+    Raises:
+        DataNotFoundError: found in neither; the message says where it
+            looked (or that there is no data folder, and how to name one),
+            names close matches, and ``expected``.
+    """
+    path = Path(text).expanduser()
+    if path.exists():
+        return path
+    if path.is_absolute():
+        near = _close_names(path.parent, path.name)
+        hint = f" (did you mean {', '.join(repr(n) for n in near)}?)" if near else ""
+        raise DataNotFoundError(
+            f"{what} {str(text)!r} does not exist{hint}; expected {expected}"
+        )
+    folder = resolve_data_dir(data_dir)
+    source = _data_dir_source(data_dir)
+    candidate = folder / path
+    if candidate.exists():
+        return candidate
+    here = f"in the current folder ({str(Path.cwd())!r})"
+    if folder.is_dir():
+        there = f"nor in the data folder {str(folder)!r} ({source})"
+        near = _close_names(candidate.parent, candidate.name)
+        if near:
+            parent = path.parent
+            there += (
+                " (did you mean "
+                + ", ".join(repr(str(parent / n)) for n in near)
+                + "?)"
+            )
+    else:
+        there = (
+            f"and there is no data folder ({source}: {str(folder)!r} does not "
+            f"exist; pass --data-dir DIR or set {DATA_ENV_VAR})"
+        )
+    raise DataNotFoundError(
+        f"{what} {str(text)!r} does not exist {here} {there}; expected {expected}"
+    )
 
 
 def find_data_dir(data_dir: str | os.PathLike | None = None) -> Path | None:
@@ -90,6 +180,42 @@ def require_data_dir(data_dir: str | os.PathLike | None = None) -> Path:
             f"{DATA_ENV_VAR} to the folder holding {_DATA_LAYOUT}"
         )
     return path
+
+
+def check_input_file(
+    path: str | os.PathLike, what: str, suffixes: tuple[str, ...] = (".yaml", ".yml")
+) -> Path:
+    """Checks that ``path`` is a file to read; returns it.
+
+    Raises:
+        VicDrakeError: it is a folder (the message names one of its files
+            with ``suffixes`` as an example), or it does not exist (naming
+            close matches in its folder).
+    """
+    p = Path(path).expanduser()
+    if p.is_file():
+        return p
+    if p.is_dir():
+        files = sorted(f for f in p.iterdir() if f.suffix in suffixes and f.is_file())
+        if files:
+            example = str(Path(path) / files[0].name)
+            raise VicDrakeError(
+                f"{what} {str(path)!r} is a folder; give one of its "
+                f"{suffixes[0]} files, e.g. {example}"
+            )
+        raise VicDrakeError(
+            f"{what} {str(path)!r} is a folder (with no {suffixes[0]} files in it); "
+            f"give a {suffixes[0]} file"
+        )
+    near = _close_names(p.parent, p.name) if p.parent.is_dir() else []
+    hint = (
+        " (did you mean "
+        + ", ".join(repr(str(Path(path).parent / n)) for n in near)
+        + "?)"
+        if near
+        else ""
+    )
+    raise VicDrakeError(f"{what} {str(path)!r} does not exist{hint}")
 
 
 #: Figure files the commands' --plot can write (matplotlib's formats).

@@ -98,7 +98,8 @@ def test_too_few_in_contact_samples(capsys, tmp_path, data_dir):
         capsys,
         ["load-test", bag, "--fit-from", data_dir / "palpation" / "test_soft_1hz"],
     )
-    assert status == 2 and "contact" in err
+    # A constant target is no load cycle: refused before the fit.
+    assert status == 2 and "is not a load/unload test" in err
     status, _, err = run(
         capsys, ["load-test", data_dir / "loadcycle" / "test_soft_1", "--fit-from", bag]
     )
@@ -218,3 +219,36 @@ def test_bag_relative_to_the_data_folder(capsys, data_dir, tmp_path, monkeypatch
     status, out, _ = run(capsys, argv)
     assert status == 0
     assert json.loads(out)["lag_s"] == 0.05
+
+
+@pytest.mark.realdata
+def test_bag_relative_to_the_data_dir_option(capsys, data_dir, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.delenv("VIC_DRAKE_DATA", raising=False)
+    argv = [
+        "load-test",
+        "loadcycle/test_soft_2",
+        "--fit-from",
+        "palpation/test_soft_1hz",
+        "--data-dir",
+        data_dir,
+        "--json",
+    ]
+    status, out, err = run(capsys, argv)
+    assert status == 0, err
+    assert json.loads(out)["beta"] == 1.35
+
+
+@pytest.mark.realdata
+def test_load_test_refuses_swapped_logs(capsys, data_dir):
+    """A palpation given as the load test (and a load test as --fit-from) is
+    told by the logs' targets, before any fit."""
+    palpation = data_dir / "palpation" / "test_soft_1hz"
+    load = data_dir / "loadcycle" / "test_soft_1"
+    status, out, err = run(capsys, ["load-test", palpation, "--fit-from", load])
+    assert status == 2 and out == ""
+    assert f"load-test bag {str(palpation)!r} is not a load/unload test" in err
+    assert "the two look swapped" in err
+    status, _, err = run(capsys, ["load-test", load, "--fit-from", load])
+    assert status == 2
+    assert f"--fit-from {str(load)!r} is a load/unload test, not a palpation" in err

@@ -102,3 +102,12 @@ class _no_raise:
 
     def __exit__(self, *exc):
         return False
+
+
+def test_an_unreached_convergence_is_said_in_words():
+    from vic_drake.commands.online import _convergence_line
+
+    for value in (float("nan"), None):
+        line = _convergence_line(value)
+        assert "n/a" not in line and "not reached" in line
+    assert _convergence_line(1.234).endswith("1.23 s after first contact")

@@ -66,6 +66,22 @@ def test_missing_bag(capsys, tmp_path):
     assert status == 2 and "does not exist" in err
 
 
+def test_every_path_is_checked_before_any_log_is_read(capsys, tmp_path, monkeypatch):
+    """A bad --held-out path fails before the fitted logs are read (README:
+    paths are checked before any work)."""
+    import vic_drake.realdata as realdata
+
+    def no_read(*args, **kwargs):
+        raise AssertionError("read a log before checking every path")
+
+    monkeypatch.setattr(realdata, "read_bag", no_read)
+    (tmp_path / "bag").mkdir()
+    argv = ["fit-relaxation", tmp_path / "bag", "--held-out", tmp_path / "nope"]
+    status, _, err = run(capsys, argv)
+    assert status == 2
+    assert f"held-out bag {str(tmp_path / 'nope')!r} does not exist" in err
+
+
 @pytest.mark.realdata
 def test_load_tests_held_out_by_phase(capsys, data_dir):
     """The palpation fit's law on the load tests, phase by phase (measured):

@@ -138,3 +138,170 @@ def test_compare_real_rejects_a_bad_relaxation_before_reading_the_bag(
     err = capsys.readouterr().err
     assert "--relaxation takes G:TAU pairs" in err and repr(value) in err
     assert "Traceback" not in err
+
+
+# --- scan: the campaign's metrics, the human summary, the duration, the file --
+
+
+#: The scan command's keys before campaign_metrics (its documented output).
+SCAN_KEYS = [
+    "scenario",
+    "controller",
+    "duration_s",
+    "rtf",
+    "force_rmse_N",
+    "force_range_N",
+    "force_peak_N",
+    "tank_min_J",
+    "contact_loss_s",
+    "lifted_off",
+]
+
+
+def _no_simulation(*args, **kwargs):
+    raise AssertionError("simulated before checking the input")
+
+
+def test_scan_prints_the_campaigns_metrics_beside_its_own(tmp_path, capsys):
+    """campaign_metrics.peak_force_N is the tissue force (a campaign row's),
+    force_peak_N the sensor's pressing force: both from the same log."""
+    import pandas as pd
+
+    from vic_drake.analysis.contact import pressing_force_N
+    from vic_drake.experiments import synthetic_scenario
+    from vic_drake.experiments.campaign.run import METRIC_KEYS
+    from vic_drake.scenario import save_scenario
+
+    path = save_scenario(synthetic_scenario("vs-vf"), tmp_path / "vsvf.yaml")
+    log = tmp_path / "log.csv"
+    argv = ["scan", str(path), "--duration", "2", "--out", str(log), "--json"]
+    assert main(argv) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert list(out)[: len(SCAN_KEYS)] == SCAN_KEYS
+    assert list(out)[len(SCAN_KEYS) : len(SCAN_KEYS) + 2] == [
+        "scan_window_s",
+        "campaign_metrics",
+    ]
+    campaign = out["campaign_metrics"]
+    assert set(METRIC_KEYS) <= set(campaign)
+    assert campaign["force_limit_N"] == 15.0
+    df = pd.read_csv(log)
+    assert campaign["peak_force_N"] == pytest.approx(df["force_tissue_z_N"].max())
+    assert out["force_peak_N"] == pytest.approx(pressing_force_N(df).max())
+    assert campaign["peak_force_N"] != out["force_peak_N"]  # The sensor's noise.
+
+
+def test_scan_without_json_prints_a_summary_and_explains_a_null_rmse(tmp_path, capsys):
+    from vic_drake.experiments import synthetic_scenario
+    from vic_drake.scenario import save_scenario
+
+    path = save_scenario(synthetic_scenario("vs-cf"), tmp_path / "vscf.yaml")
+    assert main(["scan", str(path), "--duration", "0.5"]) == 0
+    text = capsys.readouterr().out
+    assert not text.lstrip().startswith("{")
+    assert "force on the patient (tissue force; the campaign's peak_force_N)" in text
+    assert "sensor force (with its noise; force_peak_N)" in text
+    # 0.5 s: the probe has not reached its scan height, so no RMSE; it says why.
+    assert "no scan window" in text and "force range and force RMSE n/a" in text
+    assert main(["scan", str(path), "--duration", "0.5", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["force_rmse_N"] is None and out["scan_window_s"] is None
+
+
+def test_a_replayed_campaign_run_takes_the_campaigns_force_limit(tmp_path, capsys):
+    from vic_drake.experiments import synthetic_scenario
+    from vic_drake.scenario import save_scenario
+
+    (tmp_path / "camp" / "scenarios").mkdir(parents=True)
+    (tmp_path / "camp" / "spec.yaml").write_text("name: c\nforce_limit_N: 5.0\n")
+    path = save_scenario(
+        synthetic_scenario("cs"), tmp_path / "camp" / "scenarios" / "run_00000.yaml"
+    )
+    assert main(["scan", str(path), "--duration", "0.1", "--json"]) == 0
+    campaign = json.loads(capsys.readouterr().out)["campaign_metrics"]
+    assert campaign["force_limit_N"] == 5.0
+    assert "spec.yaml" in campaign["force_limit_source"]
+    argv = ["scan", str(path), "--duration", "0.1", "--force-limit", "9", "--json"]
+    assert main(argv) == 0
+    assert json.loads(capsys.readouterr().out)["campaign_metrics"]["force_limit_N"] == 9
+
+
+def test_scan_refuses_a_duration_far_beyond_the_trajectory(monkeypatch, capsys):
+    import vic_drake.experiments as experiments
+
+    monkeypatch.setattr(experiments, "run_scan", _no_simulation)
+    scenario = "diagrams/nominal_vs_vf_synthetic.yaml"
+    assert main(["scan", scenario, "--duration", "1e9"]) == 2
+    err = capsys.readouterr().err
+    assert "--duration 1e+09 s is far beyond the scenario" in err
+    assert "its trajectory ends at 23.5 s" in err and "give at most 84.5 s" in err
+
+
+def test_scan_of_a_folder_or_a_bare_name(tmp_path, monkeypatch, capsys):
+    import vic_drake.experiments as experiments
+    from vic_drake.errors import VicDrakeError
+
+    def stop(scenario, **kwargs):
+        raise VicDrakeError(f"stopped before simulating {scenario.name}")
+
+    monkeypatch.setattr(experiments, "run_scan", stop)
+    (tmp_path / "a.yaml").write_text("name: a\n")
+    assert main(["scan", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert f"scenario file {str(tmp_path)!r} is a folder" in err
+    assert f"e.g. {tmp_path / 'a.yaml'}" in err
+    # A bare name is the shipped diagrams/<name>.yaml ...
+    monkeypatch.chdir(tmp_path)
+    assert main(["scan", "nominal_vs_vf_synthetic"]) == 2
+    err = capsys.readouterr().err
+    assert "the shipped" in err and "stopped before simulating nominal_vs_vf" in err
+    # ... and a misspelt one names the closest.
+    assert main(["scan", "nominal_vs_vf_synth"]) == 2
+    err = capsys.readouterr().err
+    assert "did you mean diagrams/nominal_vs_vf_synthetic.yaml" in err
+
+
+@pytest.mark.realdata
+def test_compare_real_refuses_settings_the_controller_does_not_have(
+    data_dir, monkeypatch, capsys
+):
+    import importlib
+
+    # The module (vic_drake.experiments.compare_real is also the function).
+    module = importlib.import_module("vic_drake.experiments.compare_real")
+    monkeypatch.setattr(module, "run_scan", _no_simulation)
+    bag = str(data_dir / "experiments" / "test_tracking5")
+    assert main(["compare-real", bag, "--stiffness", "400"]) == 2
+    err = capsys.readouterr().err
+    assert "--stiffness applies to CS; this log was identified as vs-cf" in err
+    assert "--controller cs" in err
+    assert main(["compare-real", bag, "--controller", "cs", "--force", "7"]) == 2
+    err = capsys.readouterr().err
+    assert "--force applies to CF and VS-CF, not to the given controller cs" in err
+
+
+@pytest.mark.realdata
+def test_compare_real_refuses_a_duration_short_of_the_contact_window(
+    data_dir, monkeypatch, capsys
+):
+    import importlib
+
+    # The module (vic_drake.experiments.compare_real is also the function).
+    module = importlib.import_module("vic_drake.experiments.compare_real")
+    monkeypatch.setattr(module, "run_scan", _no_simulation)
+    bag = str(data_dir / "experiments" / "test_tracking5")
+    assert main(["compare-real", bag, "--duration", "0.5"]) == 2
+    err = capsys.readouterr().err
+    assert "duration 0.5 s ends before the real log's contact window" in err
+    assert "simulate longer than 1.69 s" in err
+
+
+@pytest.mark.realdata
+def test_compare_real_finds_a_relative_bag_in_the_data_dir(
+    data_dir, tmp_path, monkeypatch, capsys
+):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.delenv("VIC_DRAKE_DATA", raising=False)
+    argv = ["compare-real", "experiments/test_tracking5", "--data-dir", str(data_dir)]
+    assert main([*argv, "--duration", "2.5", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["controller"] == "vs-cf"

@@ -141,3 +141,21 @@ def test_cs_and_cf_logs_ran_with_the_fzi_default_gains(data_dir):
         assert (s.fdcc.p_gains[2], s.fdcc.d_gains[2]) == FZI_DEFAULT_FDCC_Z_GAINS
     s = scenario_from_real_log(real, name=name, fdcc_z_gains=PAPER_FDCC_Z_GAINS)
     assert s.fdcc.p_gains[2] == PAPER_FDCC_Z_GAINS[0]
+
+
+def test_a_setting_the_controller_does_not_have_is_refused():
+    from vic_drake.experiments.real_logs import check_settings_apply
+
+    check_settings_apply("cs", False, 400.0, None, None)
+    check_settings_apply("vs-cf", True, None, 7.0, 0.1)
+    check_settings_apply("vs-vf", False, None, None, 1e-5)
+    with pytest.raises(VicDrakeError) as exc:
+        check_settings_apply("vs-cf", False, 400.0, None, None)
+    assert str(exc.value) == (
+        "--stiffness applies to CS; this log was identified as vs-cf (pass "
+        "--controller cs to run that instead, or drop --stiffness)"
+    )
+    with pytest.raises(VicDrakeError, match="--force applies to CF and VS-CF, not"):
+        check_settings_apply("cs", True, None, 7.0, None)
+    with pytest.raises(VicDrakeError, match="--R applies to VS-CF and VS-VF"):
+        check_settings_apply("cf", False, None, None, 0.1)

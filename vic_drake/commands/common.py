@@ -7,17 +7,60 @@ import sys
 
 from vic_drake.errors import VicDrakeError
 from vic_drake.jsonio import to_json
-from vic_drake.paths import DATA_ENV_VAR
+from vic_drake.paths import DATA_ENV_VAR, WITHOUT_DATA_SYNTHETIC
+
+#: What the bag-reading commands do without a data folder (check_data_dir).
+WITHOUT_DATA_BAGS = "read bag paths only as given"
 
 
-def add_data_dir_option(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument(
-        "--data-dir",
-        default=None,
-        metavar="DIR",
-        help=f"the paper's measurements (default: ${DATA_ENV_VAR}, else ../shared/data "
-        "beside the project)",
+def add_data_dir_option(
+    parser: argparse.ArgumentParser,
+    without: str | None = WITHOUT_DATA_SYNTHETIC,
+    *,
+    bags: bool = False,
+) -> None:
+    """The one ``--data-dir DIR`` option (the data folder, paths.resolve_data_dir).
+
+    Args:
+        without: what the command does without a data folder (the bad-folder
+            error's "omit the option to ..."; paths.check_data_dir); None
+            when it needs the data.
+        bags: the command reads bags, which are also looked up in the data
+            folder (:func:`bag_path`).
+    """
+    text = (
+        f"the paper's measurements (default: ${DATA_ENV_VAR}, else ../shared/data "
+        "beside the project)"
     )
+    if bags:
+        text += "; a relative BAG_DIR that is not in the current folder is read from it"
+    parser.add_argument("--data-dir", default=None, metavar="DIR", help=text)
+    parser.set_defaults(without_data=without)
+
+
+def add_bag_data_dir_option(parser: argparse.ArgumentParser) -> None:
+    """``--data-dir`` of a command that reads bags (and needs nothing else there)."""
+    add_data_dir_option(parser, WITHOUT_DATA_BAGS, bags=True)
+
+
+def bag_path(args: argparse.Namespace, text: str, what: str = "bag", expected=None):
+    """The bag ``text`` names: as given, else in the data folder (paths.find_bag).
+
+    Raises:
+        DataNotFoundError: naming where it looked and ``expected``.
+    """
+    from vic_drake.paths import find_bag
+
+    kwargs = {} if expected is None else {"expected": expected}
+    return find_bag(text, getattr(args, "data_dir", None), what=what, **kwargs)
+
+
+def help_text(doc: str, paragraph: int | None = None) -> str:
+    """A docstring (or one of its paragraphs) as --help text: reST's double
+    backticks dropped (argparse prints them as they are)."""
+    if paragraph is not None:
+        doc = doc.split("\n\n")[paragraph]
+    return doc.replace("``", "")
 
 
 def add_json_option(parser: argparse.ArgumentParser) -> None:

@@ -8,7 +8,12 @@ import math
 import os
 import sys
 
-from vic_drake.commands.common import add_json_option, emit
+from vic_drake.commands.common import (
+    add_bag_data_dir_option,
+    add_json_option,
+    bag_path,
+    emit,
+)
 from vic_drake.errors import VicDrakeError
 
 
@@ -26,13 +31,17 @@ def register(subparsers) -> None:
         ),
     )
     parser.add_argument(
-        "bag_dir", metavar="BAG_DIR", help="ROS 2 bag folder (31-column log)"
+        "bag_dir",
+        metavar="BAG_DIR",
+        help="ROS 2 bag folder of a 31-column log (absolute, relative, or relative "
+        "to the data folder, e.g. experiments/test_tracking5)",
     )
     parser.add_argument(
         "--R",
         dest="r_weight",
         type=float,
         default=0.1,
+        metavar="R",
         help="stiffness regularisation weight R on every axis (> 0; default 0.1)",
     )
     parser.add_argument(
@@ -42,6 +51,7 @@ def register(subparsers) -> None:
         help="QP solver: osqp (default) or clarabel through Drake's MathematicalProgram, "
         "or exact, the closed-form solver (same answer, faster)",
     )
+    add_bag_data_dir_option(parser)
     add_json_option(parser)
     parser.set_defaults(handler=run_replay_qp)
 
@@ -74,8 +84,14 @@ def run_replay_qp(args: argparse.Namespace) -> int:
     r = args.r_weight
     if not (math.isfinite(r) and r > 0.0):
         raise VicDrakeError(f"--R must be a finite number > 0; got {r!r}")
+    bag = bag_path(
+        args,
+        args.bag_dir,
+        expected="a ROS 2 bag folder (metadata.yaml + .db3) of a 31-column "
+        "variable-impedance log",
+    )
     with native_stdout_to_stderr():
-        result = replay_bag(args.bag_dir, r_weight=r, solver=args.solver)
+        result = replay_bag(bag, r_weight=r, solver=args.solver)
     summary = result.summary()
     human = (
         f"replay-qp {args.bag_dir} (R = {r:g}, solver {summary['solver']}): "

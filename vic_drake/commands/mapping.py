@@ -32,6 +32,12 @@ from vic_drake.paths import check_output_dir
 
 MAX_MAP_POINTS = 20_000_000  # 2001 x 1001 at 0.1 mm over 20 x 10 cm is 2 M.
 MAX_PALPATION_POINTS = 5_000
+#: --phantom and --kernel choices (tissue.phantom.PHANTOM_KINDS and
+#: estimation.gp_fit.KERNELS, written out: those modules load scikit-learn and
+#: pydrake, which --help does not wait for; tests/commands/test_map.py checks
+#: they agree).
+PHANTOMS = ("synthetic", "measured")
+GP_KERNELS = ("rbf", "matern")
 METRIC_KEYS = (
     "points",
     "kappa_rmse_pct",
@@ -56,6 +62,7 @@ def register(subparsers) -> None:
     )
     parser.add_argument(
         "--phantom",
+        choices=PHANTOMS,
         default="synthetic",
         help="synthetic (default) or measured (the paper's map; needs the data)",
     )
@@ -86,7 +93,10 @@ def register(subparsers) -> None:
         "--seed", type=int, default=0, help="sensor-noise seed (default 0)"
     )
     parser.add_argument(
-        "--kernel", default="rbf", help="GP kernel shape: rbf (default) or matern"
+        "--kernel",
+        choices=GP_KERNELS,
+        default="rbf",
+        help="GP kernel shape: rbf (default) or matern",
     )
     parser.add_argument(
         "--time-step-ms",
@@ -140,7 +150,7 @@ def _prepare_out(path: str) -> Path:
 def run_map(args) -> int:
     # Heavy (pydrake, scikit-learn): imported when the command runs, not when
     # the parser is built.
-    from vic_drake.estimation.gp_fit import KERNELS, GpMapParams
+    from vic_drake.estimation.gp_fit import GpMapParams
     from vic_drake.experiments import (
         CampaignParams,
         default_region,
@@ -148,16 +158,10 @@ def run_map(args) -> int:
         run_map_pipeline,
     )
     from vic_drake.systems.indenter import IndenterParams
-    from vic_drake.tissue.phantom import PHANTOM_KINDS, load_phantom
+    from vic_drake.tissue.phantom import load_phantom
 
     start = time.perf_counter()
     progress = Progress(True)
-    if args.phantom not in PHANTOM_KINDS:
-        raise VicDrakeError(
-            f"--phantom must be one of {PHANTOM_KINDS}; got {args.phantom!r}"
-        )
-    if args.kernel not in KERNELS:
-        raise VicDrakeError(f"--kernel must be one of {KERNELS}; got {args.kernel!r}")
     resolution_m = _positive(args.resolution_mm, "--resolution-mm") * 1e-3
     spacing_m = _positive(args.spacing_cm, "--spacing-cm") * 1e-2
     time_step_s = _positive(args.time_step_ms, "--time-step-ms") * 1e-3

@@ -23,12 +23,15 @@ from pathlib import Path
 
 from vic_drake.commands.common import (
     Progress,
+    add_bag_data_dir_option,
     add_json_option,
+    bag_path,
     emit,
+    help_text,
     parse_float_list,
 )
-from vic_drake.errors import DataNotFoundError, VicDrakeError
-from vic_drake.paths import PLOT_SUFFIXES, check_output_file, resolve_data_dir
+from vic_drake.errors import VicDrakeError
+from vic_drake.paths import PLOT_SUFFIXES, check_output_file
 
 _RELATIVE_HELP = (
     "Relative residual = RMS residual / RMS fitted force over the in-contact "
@@ -65,27 +68,54 @@ def _check_nonneg(value: float, option: str) -> float:
     return value
 
 
-def _bag_path(text: str) -> Path:
-    """The bag folder as given, else relative to the data folder."""
-    path = Path(text).expanduser()
-    if path.exists() or path.is_absolute():
-        return path
-    candidate = resolve_data_dir() / path
-    return candidate if candidate.exists() else path
+#: What the offline commands read: the rig's 6-column palpation/loadcycle logs.
+PALPATION_EXPECTED = (
+    "a ROS 2 bag folder (metadata.yaml + .db3) of the 6-column palpation/loadcycle "
+    "layout"
+)
 
 
-def _read_palpation(text: str, role: str):
+def _find_palpation(args: argparse.Namespace, text: str, role: str) -> Path:
+    """The bag folder ``text`` names (as given, else in the data folder)."""
+    return bag_path(args, text, role, PALPATION_EXPECTED)
+
+
+def _read_palpation(path: Path):
+    """A found bag (:func:`_find_palpation`) as PalpationData."""
     from vic_drake.estimation.palpation import PalpationData
     from vic_drake.realdata import read_bag
 
-    path = _bag_path(text)
-    if not path.exists():
-        raise DataNotFoundError(
-            f"{role} {text!r} does not exist; expected a ROS 2 bag folder "
-            "(metadata.yaml + .db3) of the 6-column palpation/loadcycle layout"
-        )
     df = read_bag(path, expect="palpation")
     return PalpationData.from_frame(df)
+
+
+def _check_roles(load, palpation, load_text: str, palpation_text: str) -> None:
+    """Refuses a load test that is not a load cycle, or a palpation that is one
+    (the two arguments swapped), by the logs' targets
+    (:func:`vic_drake.estimation.loadtest.load_test_phases`)."""
+    from vic_drake.estimation.loadtest import load_test_phases
+
+    def is_cycle(data):
+        return load_test_phases(data.t_s, data.z_target_m) is not None
+
+    load_ok, palpation_is_cycle = is_cycle(load), is_cycle(palpation)
+    swap = (
+        " (the two look swapped: pass the load test as BAG_DIR and the palpation "
+        "as --fit-from)"
+        if not load_ok and palpation_is_cycle
+        else ""
+    )
+    if not load_ok:
+        raise VicDrakeError(
+            f"load-test bag {load_text!r} is not a load/unload test: its target does "
+            f"not descend once and rise once (a palpation's goes up and down){swap}"
+        )
+    if palpation_is_cycle:
+        raise VicDrakeError(
+            f"--fit-from {palpation_text!r} is a load/unload test, not a palpation: "
+            "the models are fitted on a sinusoidal palpation (e.g. "
+            "palpation/test_soft_1hz)"
+        )
 
 
 def _add_fit_options(parser: argparse.ArgumentParser) -> None:
@@ -127,9 +157,10 @@ def _fit_palpation(args: argparse.Namespace) -> int:
     mass = _check_nonneg(args.indenter_mass, "--indenter-mass")
     if args.plot:  # Checked before the fits: a bad path fails now.
         check_output_file(args.plot, "--plot", PLOT_SUFFIXES)
+    path = _find_palpation(args, args.bag_dir, "palpation bag")
     say = Progress()
-    say(f"reading {args.bag_dir}")
-    data = _read_palpation(args.bag_dir, "palpation bag")
+    say(f"reading {path}")
+    data = _read_palpation(path)
     result = compare_models(
         data,
         betas,
@@ -206,10 +237,14 @@ def _load_test(args: argparse.Namespace) -> int:
     mass = _check_nonneg(args.indenter_mass, "--indenter-mass")
     if args.plot:  # Checked before the fits: a bad path fails now.
         check_output_file(args.plot, "--plot", PLOT_SUFFIXES)
+    # Both paths are found before either log is read.
+    load_path = _find_palpation(args, args.bag_dir, "load-test bag")
+    fit_path = _find_palpation(args, args.fit_from, "--fit-from palpation bag")
     say = Progress()
-    say(f"reading {args.bag_dir} and {args.fit_from}")
-    load = _read_palpation(args.bag_dir, "load-test bag")
-    palpation = _read_palpation(args.fit_from, "--fit-from palpation bag")
+    say(f"reading {load_path} and {fit_path}")
+    load = _read_palpation(load_path)
+    palpation = _read_palpation(fit_path)
+    _check_roles(load, palpation, args.bag_dir, args.fit_from)
     result = load_test(
         load,
         palpation,
@@ -250,7 +285,7 @@ def register(subparsers) -> None:
     p = subparsers.add_parser(
         "fit-palpation",
         help="fit Kelvin-Voigt and Hunt-Crossley to a palpation bag (Table I)",
-        description=__doc__.split("\n\n")[1] + " " + _RELATIVE_HELP,
+        description=help_text(__doc__, 1) + " " + _RELATIVE_HELP,
     )
     p.add_argument(
         "bag_dir",
@@ -266,20 +301,27 @@ def register(subparsers) -> None:
     )
     _add_fit_options(p)
     p.add_argument("--plot", default=None, metavar="FILE", help="save a summary figure")
+    add_bag_data_dir_option(p)
     add_json_option(p)
     p.set_defaults(handler=_fit_palpation)
 
     q = subparsers.add_parser(
         "load-test",
         help="predict a load/unload test with models fitted on a palpation (Fig. 2)",
-        description=__doc__.split("\n\n")[2],
+        description=help_text(__doc__, 2),
     )
-    q.add_argument("bag_dir", metavar="BAG_DIR", help="6-column load-test bag folder")
+    q.add_argument(
+        "bag_dir",
+        metavar="BAG_DIR",
+        help="6-column load-test bag folder (absolute, relative, or relative to the "
+        "data folder, e.g. loadcycle/test_soft_1)",
+    )
     q.add_argument(
         "--fit-from",
         required=True,
         metavar="PALPATION_BAG_DIR",
-        help="palpation bag the model parameters are fitted on",
+        help="palpation bag the model parameters are fitted on (found as BAG_DIR, "
+        "e.g. palpation/test_soft_1hz)",
     )
     q.add_argument(
         "--beta",
@@ -289,5 +331,6 @@ def register(subparsers) -> None:
     )
     _add_fit_options(q)
     q.add_argument("--plot", default=None, metavar="FILE", help="save the Fig. 2 plot")
+    add_bag_data_dir_option(q)
     add_json_option(q)
     q.set_defaults(handler=_load_test)

@@ -12,16 +12,15 @@ from __future__ import annotations
 
 import argparse
 import math
-from pathlib import Path
 
 from vic_drake.commands.common import (
     Progress,
-    add_data_dir_option,
+    add_bag_data_dir_option,
     add_json_option,
+    bag_path,
     emit,
 )
-from vic_drake.errors import DataNotFoundError, VicDrakeError
-from vic_drake.paths import resolve_data_dir
+from vic_drake.errors import VicDrakeError
 
 
 def _estimate_online(args: argparse.Namespace) -> int:
@@ -34,15 +33,13 @@ def _estimate_online(args: argparse.Namespace) -> int:
         raise VicDrakeError(f"--lag must be in [0, 1] s; got {args.lag!r}")
     if not (math.isfinite(args.beta) and 0.0 < args.beta <= 3.0):
         raise VicDrakeError(f"--beta must be in (0, 3]; got {args.beta!r}")
-    path = Path(args.bag_dir).expanduser()
-    if not path.exists() and not path.is_absolute():
-        path = resolve_data_dir(args.data_dir) / path
-    if not path.exists():
-        raise DataNotFoundError(
-            f"bag {args.bag_dir!r} does not exist; expected a ROS 2 bag folder "
-            "(metadata.yaml + .db3) of the 6-column palpation or the 31-column "
-            "variable-impedance layout"
-        )
+    path = bag_path(
+        args,
+        args.bag_dir,
+        "bag",
+        "a ROS 2 bag folder (metadata.yaml + .db3) of the 6-column palpation or "
+        "the 31-column variable-impedance layout",
+    )
     say = Progress()
     say(f"replaying {args.bag_dir} through the {args.method.upper()} estimator")
     if args.surface_walk is not None and args.method != "ekf":
@@ -77,13 +74,26 @@ def _estimate_online(args: argparse.Namespace) -> int:
             f"correlation {fmt(s['kappa_corr'], '.3f')}, at the last contact sample "
             f"{fmt(result.final_kappa_rel_err, '.3f')}",
             f"lambda: median relative error {fmt(s['lambda_rel_err_median'], '.3f')}",
-            f"convergence (kappa stays within 10 %): {fmt(s['convergence_s'], '.2f')} s "
-            "after first contact",
+            _convergence_line(s["convergence_s"]),
             f"tick cost p99 {s['tick_us_p99']:.1f} us (as a function)",
         ]
     )
     emit(s, args.json, human)
     return 0
+
+
+def _convergence_line(convergence_s) -> str:
+    """The convergence time in words; NaN/None: not reached (convergence_time_s)."""
+    if convergence_s is None or not math.isfinite(convergence_s):
+        return (
+            "convergence (kappa stays within 10 %): not reached (kappa is more than "
+            "10 % off the reference at the last contact sample, or the log has no "
+            "contact)"
+        )
+    return (
+        f"convergence (kappa stays within 10 %): {convergence_s:.2f} s after first "
+        "contact"
+    )
 
 
 def register(subparsers) -> None:
@@ -127,6 +137,6 @@ def register(subparsers) -> None:
         help="EKF only: estimate a surface offset too, with this random walk in "
         "m/sqrt(s) (default: trust the surface of the log or map)",
     )
-    add_data_dir_option(p)
+    add_bag_data_dir_option(p)
     add_json_option(p)
     p.set_defaults(handler=_estimate_online)

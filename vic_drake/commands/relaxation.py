@@ -12,8 +12,19 @@ from __future__ import annotations
 
 import math
 
-from vic_drake.commands.common import Progress, add_json_option, emit, parse_float_list
-from vic_drake.commands.offline import _add_fit_options, _read_palpation
+from vic_drake.commands.common import (
+    Progress,
+    add_bag_data_dir_option,
+    add_json_option,
+    emit,
+    help_text,
+    parse_float_list,
+)
+from vic_drake.commands.offline import (
+    _add_fit_options,
+    _find_palpation,
+    _read_palpation,
+)
 from vic_drake.errors import VicDrakeError
 
 
@@ -29,8 +40,8 @@ def _initial_time_constants(text: str | None) -> tuple[float, ...]:
     return tuple(taus)
 
 
-def _aligned(bags, args, say) -> tuple[dict, dict]:
-    """{name: aligned PalpationData}, {name: lag_s} of bag folders.
+def _aligned(bags: dict, args, say) -> tuple[dict, dict]:
+    """{name: aligned PalpationData}, {name: lag_s} of found bags ({name: path}).
 
     Each log is aligned by its own estimated lag (or ``--lag``); a lag
     estimated at 0 (not identified: a load test has no sinusoid) takes the
@@ -41,11 +52,8 @@ def _aligned(bags, args, say) -> tuple[dict, dict]:
     from vic_drake.estimation.palpation import estimate_lag, shift
 
     raw, lags = {}, {}
-    for text in bags:
-        data = _read_palpation(text, "bag")
-        name = text.rstrip("/")
-        if name in raw:
-            raise VicDrakeError(f"bag {text!r} is given twice")
+    for name, path in bags.items():
+        data = _read_palpation(path)
         raw[name] = data
         lags[name] = (
             args.lag if args.lag is not None else estimate_lag(data, args.max_lag)
@@ -57,6 +65,17 @@ def _aligned(bags, args, say) -> tuple[dict, dict]:
     for name, lag in lags.items():
         say(f"  {name}: sensor lag {lag * 1e3:.1f} ms")
     return {n: shift(d, lags[n]) for n, d in raw.items()}, lags
+
+
+def _found(args, texts, role: str) -> dict:
+    """{name as given: found bag path} (:func:`_find_palpation`), in order."""
+    found = {}
+    for text in texts:
+        name = text.rstrip("/")
+        if name in found:
+            raise VicDrakeError(f"{role} {text!r} is given twice")
+        found[name] = _find_palpation(args, text, role)
+    return found
 
 
 def _fit_relaxation(args) -> int:
@@ -75,15 +94,16 @@ def _fit_relaxation(args) -> int:
         raise VicDrakeError(
             f"--max-tau must exceed every --tau0 ({max(taus):g} s); got {args.max_tau!r}"
         )
+    # Every path, fitted and held out, is found before any log is read, so a
+    # bad one fails at once.
+    bags = _found(args, args.bags, "bag")
+    held_paths = _found(args, args.held_out, "held-out bag")
     say(f"fitting {len(taus)} relaxation branch(es) on {len(args.bags)} log(s)")
-    logs, lags = _aligned(args.bags, args, say)
-    # Held-out logs are read (and checked) before the fit, so a bad path
-    # fails at once. Each is aligned by its own lag; a lag estimated at 0
-    # (not identified: a load test has no sinusoid) takes the fitted logs'
-    # median instead.
-    held_raw = {
-        t.rstrip("/"): _read_palpation(t, "held-out bag") for t in args.held_out
-    }
+    logs, lags = _aligned(bags, args, say)
+    # Each held-out log is aligned by its own lag; a lag estimated at 0 (not
+    # identified: a load test has no sinusoid) takes the fitted logs' median
+    # instead.
+    held_raw = {n: _read_palpation(p) for n, p in held_paths.items()}
     fit = fit_relaxation(
         logs,
         beta=args.beta,
@@ -166,7 +186,7 @@ def register(subparsers) -> None:
     p = subparsers.add_parser(
         "fit-relaxation",
         help="fit the relaxing Hunt-Crossley law to palpation logs, score held-out logs",
-        description=__doc__.split("\n\n")[1],
+        description=help_text(__doc__, 1),
     )
     p.add_argument(
         "bags",
@@ -205,5 +225,6 @@ def register(subparsers) -> None:
         help="Hunt-Crossley exponent, in (0, 3] (default %(default)s)",
     )
     _add_fit_options(p)
+    add_bag_data_dir_option(p)
     add_json_option(p)
     p.set_defaults(handler=_fit_relaxation)

@@ -19,8 +19,17 @@ from vic_drake.commands.common import (
     Progress,
     add_data_dir_option,
     add_json_option,
+    bag_path,
     emit,
     parse_relaxation,
+)
+from vic_drake.commands.scan_summary import (
+    MAX_EXTRA_DURATION_S,
+    SCAN_DESCRIPTION,
+    check_scan_duration,
+    scan_human_summary,
+    scan_metrics_dict,
+    scenario_path,
 )
 from vic_drake.errors import VicDrakeError
 from vic_drake.paths import PLOT_SUFFIXES, check_output_file
@@ -95,7 +104,12 @@ def register(subparsers) -> None:
             "window (first contact + 1 s to last contact)."
         ),
     )
-    p.add_argument("bag_dir", metavar="BAG_DIR", help="ROS 2 bag folder of a scan")
+    p.add_argument(
+        "bag_dir",
+        metavar="BAG_DIR",
+        help="ROS 2 bag folder of a scan (absolute, relative, or relative to the "
+        "data folder, e.g. experiments/test_tracking5)",
+    )
     p.add_argument(
         "--controller",
         choices=("cs", "cf", "vs-cf", "vs-vf"),
@@ -106,26 +120,30 @@ def register(subparsers) -> None:
         "--stiffness",
         metavar="N_PER_M",
         default=None,
-        help="CS stiffness, N/m (default: identified from the log)",
+        help="CS stiffness, N/m (default: identified from the log; an error for "
+        "another controller)",
     )
     p.add_argument(
         "--force",
         metavar="N",
         default=None,
-        help="CF / VS-CF force reference, N (default: identified from the log)",
+        help="CF / VS-CF force reference, N (default: identified from the log; an "
+        "error for another controller)",
     )
     p.add_argument(
         "--R",
         dest="r_weight",
         metavar="R",
         default=None,
-        help="stiffness QP weight R (> 0; default: identified from the log)",
+        help="stiffness QP weight R of VS-CF / VS-VF (> 0; default: identified from "
+        "the log; an error for another controller)",
     )
     p.add_argument(
         "--duration",
         metavar="S",
         default=None,
-        help="simulate only the first S seconds",
+        help="simulate only the first S seconds (default: the whole log); must "
+        "reach into the log's contact window",
     )
     p.add_argument(
         "--tissue-law",
@@ -172,16 +190,38 @@ def register(subparsers) -> None:
         default=None,
         help="save the simulated log (.parquet or .csv)",
     )
-    add_data_dir_option(p)
+    # compare-real needs the measured map: no run without the data.
+    add_data_dir_option(p, without=None, bags=True)
     add_json_option(p)
     p.set_defaults(handler=run_compare_real)
 
     s = subparsers.add_parser(
         "scan",
         help="simulate a scenario YAML (diagrams/*.yaml) and print its scan metrics",
+        description=SCAN_DESCRIPTION,
     )
-    s.add_argument("scenario", metavar="SCENARIO.yaml")
-    s.add_argument("--duration", metavar="S", default=None, help="simulated time, s")
+    s.add_argument(
+        "scenario",
+        metavar="SCENARIO.yaml",
+        help="a scenario file: diagrams/*.yaml, a campaign's scenarios/run_*.yaml, "
+        "a reproduce run's logs/*.scenario.yaml, or the name of a shipped one "
+        "(nominal_vs_vf_synthetic for diagrams/nominal_vs_vf_synthetic.yaml)",
+    )
+    s.add_argument(
+        "--duration",
+        metavar="S",
+        default=None,
+        help="simulated time, s (default: the scenario's duration_s, else its "
+        f"trajectory's end + 1 s; at most {MAX_EXTRA_DURATION_S:g} s beyond that)",
+    )
+    s.add_argument(
+        "--force-limit",
+        metavar="N",
+        default=None,
+        help="the force limit of time_above_limit_s, N (default: the campaign's "
+        "force_limit_N when SCENARIO.yaml is one of a campaign's runs, else "
+        "15, the campaigns' default)",
+    )
     s.add_argument(
         "--out", metavar="FILE", default=None, help="save the log (.parquet or .csv)"
     )
@@ -232,9 +272,15 @@ def run_compare_real(args: argparse.Namespace) -> int:
         check_output_file(args.out, "--out", LOG_SUFFIXES)
     if args.plot:
         check_output_file(args.plot, "--plot", PLOT_SUFFIXES)
+    bag = bag_path(
+        args,
+        args.bag_dir,
+        expected="a ROS 2 bag folder (metadata.yaml + .db3) of a scan: 31 columns "
+        "(VS controller) or 9 columns (CS/CF)",
+    )
     progress = Progress(True)
     out, sim, real = compare_real(
-        args.bag_dir,
+        bag,
         controller=args.controller,
         stiffness_N_per_m=stiffness,
         force_N=force,
@@ -268,12 +314,20 @@ def run_compare_real(args: argparse.Namespace) -> int:
 
 
 def run_scan_command(args: argparse.Namespace) -> int:
-    from vic_drake.analysis import contact, scan_metrics
     from vic_drake.experiments import run_scan
     from vic_drake.scenario import load_scenario, save_scenario
 
-    scenario = load_scenario(args.scenario)
+    progress = Progress(True)
+    path = scenario_path(args.scenario, progress)
+    scenario = load_scenario(path)
     duration = None if args.duration is None else _positive(args.duration, "--duration")
+    if duration is not None:
+        check_scan_duration(scenario, duration)
+    force_limit = (
+        None
+        if args.force_limit is None
+        else _positive(args.force_limit, "--force-limit")
+    )
     if args.out:  # Checked before simulating, as --bag below.
         check_output_file(args.out, "--out", LOG_SUFFIXES)
     if args.bag:
@@ -284,31 +338,16 @@ def run_scan_command(args: argparse.Namespace) -> int:
         check_bag_target(args.bag, option="--bag")
         check_bag_scenario(scenario)
     result = run_scan(
-        scenario, duration_s=duration, data_dir=args.data_dir, progress=Progress(True)
+        scenario, duration_s=duration, data_dir=args.data_dir, progress=progress
     )
-    df = result.df
-    out = {
-        "scenario": scenario.name,
-        "controller": scenario.controller.reference.controller,
-        "duration_s": result.sim_s,
-        "rtf": result.rtf,
-        # CS has no force reference: its RMSE against one is undefined.
-        "force_rmse_N": None
-        if scenario.controller.reference.controller == "cs"
-        else scan_metrics.force_rmse_N(df),
-        "force_range_N": list(scan_metrics.force_range_N(df)),
-        "force_peak_N": scan_metrics.peak_force_N(df),
-        "tank_min_J": scan_metrics.tank_min_J(df),
-        "contact_loss_s": [list(i) for i in contact.contact_loss_intervals(df)],
-        "lifted_off": scan_metrics.lifted_off(df),
-    }
+    out = scan_metrics_dict(scenario, result, path, force_limit)
     if args.out:
-        path = _save_log(df, args.out)
-        save_scenario(scenario, path.with_suffix(".scenario.yaml"))
-        out["log"] = str(path)
+        log = _save_log(result.df, args.out)
+        save_scenario(scenario, log.with_suffix(".scenario.yaml"))
+        out["log"] = str(log)
     if args.bag:
         from vic_drake.experiments.rig_log import write_scan_bag
 
         out["bag"] = str(write_scan_bag(result, args.bag))
-    emit(out, args.json)
+    emit(out, args.json, scan_human_summary(out, scenario))
     return 0

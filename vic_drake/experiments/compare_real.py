@@ -85,6 +85,30 @@ def phantom_replay(bag: Path, real, phantom):
     return motion, replay_table(motion, surface_error_m=surface_error), surface_error
 
 
+def check_duration_reaches_window(real, duration_s: float | None) -> None:
+    """Refuses, before simulating, a duration that ends before the real log's
+    contact window (where the comparison is made: first contact + 1 s until
+    the final lift, :func:`~vic_drake.analysis.contact.scan_window`).
+
+    Raises:
+        VicDrakeError: naming the window and the log's length.
+    """
+    if duration_s is None:
+        return
+    window = scan_window(real)
+    if not window.any():
+        return  # compare_with_real names a log without a window.
+    t = real["t_s"].to_numpy(float)
+    start, end = float(t[window][0]), float(t[window][-1])
+    if duration_s <= start:
+        raise VicDrakeError(
+            f"duration {duration_s:g} s ends before the real log's contact window "
+            f"({start:.2f}-{end:.2f} s: first contact + 1 s until the final lift), "
+            f"where the runs are compared; simulate longer than {start:.2f} s (the "
+            f"whole log, the default, is {float(t[-1]):.1f} s)"
+        )
+
+
 def compare_real(
     bag_dir,
     *,
@@ -202,6 +226,7 @@ def compare_real(
         r_weight=r_weight,
     )
     real = real_to_canonical(raw)
+    check_duration_reaches_window(real, duration_s)
     published = load_phantom("measured", data_dir=data_dir, lookup="bilinear")
     surface = surface_calibration(
         real,

@@ -211,12 +211,66 @@ def identify_real_log(
             "a 9-column log is a CS or CF scan; --controller must be cs or cf, "
             f"got {controller!r}"
         )
+    if controller is not None:
+        check_settings_apply(controller, True, stiffness_N_per_m, force_N, r_weight)
     if controller is None:
-        return identify_controller(real, r_weight=r_weight)
+        found = identify_controller(real, r_weight=r_weight)
+        check_settings_apply(
+            found.controller, False, stiffness_N_per_m, force_N, r_weight
+        )
+        return found
     setting = {"cs": stiffness_N_per_m, "cf": force_N}.get(controller)
     if layout == "scan" and setting is not None:
         return ControllerIdentification(controller, given=True)
     return identify_controller(real, controller=controller, r_weight=r_weight)
+
+
+#: The settings each controller takes: (argument name, command-line option,
+#: the controllers it applies to).
+_SETTINGS = (
+    ("stiffness_N_per_m", "--stiffness", ("cs",)),
+    ("force_N", "--force", ("cf", "vs-cf")),
+    ("r_weight", "--R", ("vs-cf", "vs-vf")),
+)
+
+
+def check_settings_apply(
+    controller: str,
+    given: bool,
+    stiffness_N_per_m: float | None,
+    force_N: float | None,
+    r_weight: float | None,
+) -> None:
+    """Refuses a setting that the controller does not have (it would be ignored).
+
+    Args:
+        controller: the controller that runs.
+        given: it was given (else identified from the log).
+
+    Raises:
+        VicDrakeError: "--stiffness applies to CS; this log was identified as
+            vs-cf (pass --controller cs)", or, with ``given``, "... not to the
+            given controller vs-cf".
+    """
+    values = {
+        "stiffness_N_per_m": stiffness_N_per_m,
+        "force_N": force_N,
+        "r_weight": r_weight,
+    }
+    for name, option, applies in _SETTINGS:
+        if values[name] is None or controller in applies:
+            continue
+        to = " and ".join(c.upper() for c in applies)
+        if given:
+            raise VicDrakeError(
+                f"{option} applies to {to}, not to the given controller {controller}; "
+                f"drop {option} or pass --controller {' or '.join(applies)}"
+            )
+        raise VicDrakeError(
+            f"{option} applies to {to}; this log was identified as {controller} "
+            f"(pass --controller {' or '.join(applies)} to run that instead, or drop "
+            f"{option})"
+        )
 
 
 def scenario_from_real_log(
@@ -430,6 +484,7 @@ __all__ = [
     "PAPER_FDCC_Z_GAINS",
     "REAL_SCAN_FORCE_DELAY_S",
     "WAYPOINT_PERIOD_S",
+    "check_settings_apply",
     "detect_controller",
     "fit_target_profile",
     "identify_fdcc_z_gains",

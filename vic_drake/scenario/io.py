@@ -17,6 +17,7 @@ from pathlib import Path
 from pydrake.common.yaml import yaml_dump_typed, yaml_load, yaml_load_typed
 
 from vic_drake.errors import VicDrakeError
+from vic_drake.paths import check_input_file
 from vic_drake.scenario.scenario import Scenario
 
 
@@ -29,9 +30,7 @@ def load_scenario(path: str | os.PathLike) -> Scenario:
     Raises:
         VicDrakeError: naming the file and the offending field and value.
     """
-    path = Path(path)
-    if not path.is_file():
-        raise VicDrakeError(f"scenario file {str(path)!r} does not exist")
+    path = check_input_file(path, "scenario file")
     return _load({"filename": str(path)}, f"scenario file {str(path)!r}")
 
 

@@ -1,0 +1,232 @@
+"""What ``vic-drake scan`` checks and prints: the scenario file, the duration,
+the metrics (the scan's and the campaign's) and the human summary.
+
+Two forces are reported, under distinct names. ``force_peak_N`` (and
+``force_range_N``, ``force_rmse_N``) is the force sensor's pressing force,
+with its noise, as the controller saw it. ``campaign_metrics`` holds a
+campaign row's metrics (:func:`vic_drake.experiments.campaign.run_metrics`):
+its ``peak_force_N`` is the tissue's force on the probe (the force on the
+patient), so a campaign run replayed with ``vic-drake scan`` prints the peak
+the campaign reported.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+from pathlib import Path
+
+from vic_drake.errors import VicDrakeError
+from vic_drake.paths import DIAGRAMS_DIR
+
+SCAN_DESCRIPTION = (
+    "Simulates one scenario file (the station, phantom, controller, trajectory "
+    "and variations of a scan; diagrams/*.yaml are the paper's runs) and prints "
+    "its metrics. Two forces, under distinct names: the sensor's pressing force "
+    "(force_peak_N, force_range_N, force_rmse_N; with the sensor's noise, as the "
+    "controller saw it) and, in campaign_metrics, a campaign row's metrics, whose "
+    "peak_force_N is the tissue's force on the patient (a campaign run replayed "
+    "here prints the campaign's peak). force_range_N and force_rmse_N cover the "
+    "scan window (first contact + 1 s until the final lift; null when a short "
+    "run has none). --out saves the log and the exact scenario beside it; --bag "
+    "writes the log as a ROS 2 bag in the real rig's layout."
+)
+
+#: How far past a scenario's full run --duration may reach, s (the probe
+#: only holds still after its trajectory's end).
+MAX_EXTRA_DURATION_S = 60.0
+
+#: The campaigns' force limit when a scenario is not one of a campaign's runs
+#: (CampaignSpec.force_limit_N's default).
+DEFAULT_FORCE_LIMIT_N = 15.0
+
+
+def scenario_path(text: str, say=None) -> Path:
+    """The scenario file ``text`` names.
+
+    A bare name that is not a file here (``nominal_vs_vf_synthetic``, with
+    or without ``.yaml``) names the shipped ``diagrams/<name>.yaml`` when
+    there is one (``say`` reports it), else the error names the closest
+    shipped ones. Anything else is returned as given; load_scenario says
+    when it is a folder or missing.
+    """
+    path = Path(text).expanduser()
+    if path.exists() or len(path.parts) != 1:
+        return path
+    stem = path.stem if path.suffix in (".yaml", ".yml") else path.name
+    shipped = DIAGRAMS_DIR / f"{stem}.yaml"
+    if shipped.is_file():
+        if say is not None:
+            say(f"scenario {text!r}: the shipped {shipped}")
+        return shipped
+    names = sorted(p.stem for p in DIAGRAMS_DIR.glob("*.yaml"))
+    near = difflib.get_close_matches(stem, names, n=3, cutoff=0.6)
+    hint = (
+        "; did you mean " + ", ".join(f"diagrams/{n}.yaml" for n in near) + "?"
+        if near
+        else f"; the shipped scenarios are in {str(DIAGRAMS_DIR)!r}"
+    )
+    raise VicDrakeError(
+        f"scenario file {text!r} does not exist here nor as diagrams/{stem}.yaml{hint}"
+    )
+
+
+def check_scan_duration(scenario, duration_s: float) -> None:
+    """Refuses a --duration far beyond the scenario's trajectory.
+
+    Raises:
+        VicDrakeError: more than :data:`MAX_EXTRA_DURATION_S` past the
+            scenario's full run; the message gives the trajectory's length.
+    """
+    end = float(scenario.trajectory.end_time_s)
+    full = max(float(scenario.total_duration_s), end + 1.0)
+    limit = full + MAX_EXTRA_DURATION_S
+    if duration_s > limit:
+        raise VicDrakeError(
+            f"--duration {duration_s:g} s is far beyond the scenario: its trajectory "
+            f"ends at {end:.1f} s (the default run is {scenario.total_duration_s:.1f} "
+            f"s); give at most {limit:.1f} s"
+        )
+
+
+def campaign_force_limit(path: Path) -> tuple[float, str]:
+    """(force limit, where it came from) for a scenario file.
+
+    A campaign run's scenario (``DIR/scenarios/run_*.yaml`` beside
+    ``DIR/spec.yaml``) takes the campaign's ``force_limit_N``; any other
+    :data:`DEFAULT_FORCE_LIMIT_N`.
+    """
+    spec = path.resolve().parent.parent / "spec.yaml"
+    if path.resolve().parent.name == "scenarios" and spec.is_file():
+        import yaml
+
+        try:
+            value = float(yaml.safe_load(spec.read_text())["force_limit_N"])
+        except (OSError, yaml.YAMLError, KeyError, TypeError, ValueError):
+            value = math.nan
+        if math.isfinite(value) and value > 0:
+            return value, f"the campaign's {str(spec)!r}"
+    return DEFAULT_FORCE_LIMIT_N, "the campaigns' default"
+
+
+def scan_metrics_dict(scenario, result, path: Path, force_limit_N=None) -> dict:
+    """The scan command's result: its metrics, then the campaign's.
+
+    The first keys are the command's documented output (unchanged);
+    ``scan_window_s`` (null without one) and ``campaign_metrics`` follow.
+    """
+    import numpy as np
+
+    from vic_drake.analysis import contact, scan_metrics
+    from vic_drake.experiments.campaign import run_metrics
+
+    df = result.df
+    controller = scenario.controller.reference.controller
+    window = contact.scan_window(df)
+    t = df["t_s"].to_numpy(float)
+    if force_limit_N is None:
+        force_limit_N, limit_source = campaign_force_limit(path)
+    else:
+        limit_source = "--force-limit"
+    with np.errstate(all="ignore"):
+        campaign = run_metrics(df, force_limit_N=force_limit_N)
+    campaign["tank_floor_J"] = float(scenario.controller.tank.min_energy_J)
+    campaign["force_limit_N"] = float(force_limit_N)
+    campaign["force_limit_source"] = limit_source
+    return {
+        "scenario": scenario.name,
+        "controller": controller,
+        "duration_s": result.sim_s,
+        "rtf": result.rtf,
+        # CS has no force reference: its RMSE against one is undefined.
+        "force_rmse_N": None if controller == "cs" else scan_metrics.force_rmse_N(df),
+        "force_range_N": list(scan_metrics.force_range_N(df)),
+        "force_peak_N": scan_metrics.peak_force_N(df),
+        "tank_min_J": scan_metrics.tank_min_J(df),
+        "contact_loss_s": [list(i) for i in contact.contact_loss_intervals(df)],
+        "lifted_off": scan_metrics.lifted_off(df),
+        "scan_window_s": [float(t[window][0]), float(t[window][-1])]
+        if window.any()
+        else None,
+        "campaign_metrics": campaign,
+    }
+
+
+def _n(value, spec: str = ".3f") -> str:
+    return (
+        "n/a"
+        if value is None or not math.isfinite(float(value))
+        else format(value, spec)
+    )
+
+
+def scan_human_summary(out: dict, scenario) -> str:
+    """The scan's result in words (what prints without --json)."""
+    c = out["campaign_metrics"]
+    window = out["scan_window_s"]
+    end = float(scenario.trajectory.end_time_s)
+    lines = [
+        f"{out['scenario']} ({out['controller']}): {out['duration_s']:.2f} s "
+        f"simulated, RTF {out['rtf']:.2f}",
+        f"force on the patient (tissue force; the campaign's peak_force_N): peak "
+        f"{_n(c['peak_force_N'])} N, p99 {_n(c['p99_force_N'])} N, "
+        f"{_n(c['time_above_limit_s'], '.2f')} s above {c['force_limit_N']:g} N "
+        f"({c['force_limit_source']})",
+        f"sensor force (with its noise; force_peak_N): peak {_n(out['force_peak_N'])} N",
+    ]
+    if window is None:
+        lines.append(
+            "no scan window (the probe did not hold its scan height in contact "
+            "after first contact + 1 s"
+            + (
+                f"; the trajectory runs to {end:.1f} s: simulate longer"
+                if out["duration_s"] < end
+                else ""
+            )
+            + "): force range and force RMSE n/a"
+        )
+    else:
+        lo, hi = out["force_range_N"]
+        rmse = (
+            "no force reference (CS)"
+            if out["controller"] == "cs"
+            else f"RMSE against the reference {_n(out['force_rmse_N'])} N"
+        )
+        lines.append(
+            f"scan window {window[0]:.2f}-{window[1]:.2f} s: sensor force "
+            f"{_n(lo, '.2f')}-{_n(hi, '.2f')} N, {rmse}"
+        )
+    losses = out["contact_loss_s"]
+    if losses:
+        spans = ", ".join(f"{a:.2f}-{b:.2f} s" for a, b in losses)
+        lines.append(
+            f"contact losses: {len(losses)} ({sum(b - a for a, b in losses):.2f} s: "
+            f"{spans})"
+        )
+    else:
+        lines.append("contact losses: none")
+    tank = (
+        f"tank minimum {_n(out['tank_min_J'])} J (floor {c['tank_floor_J']:g} J)"
+        if out["controller"] in ("vs-cf", "vs-vf")
+        else "no energy tank (" + out["controller"] + ")"
+    )
+    lines.append(
+        f"{tank}; {c['qp_failures']} failed QP solves; lifted off at the end: "
+        f"{'yes' if out['lifted_off'] else 'no'}"
+    )
+    for key, what in (("log", "log"), ("bag", "bag")):
+        if key in out:
+            lines.append(f"{what} written to {out[key]}")
+    return "\n".join(lines)
+
+
+__all__ = [
+    "DEFAULT_FORCE_LIMIT_N",
+    "MAX_EXTRA_DURATION_S",
+    "SCAN_DESCRIPTION",
+    "campaign_force_limit",
+    "check_scan_duration",
+    "scan_human_summary",
+    "scan_metrics_dict",
+    "scenario_path",
+]
