@@ -82,7 +82,8 @@ def register(subparsers) -> None:
 
 
 def _claim_line(cid: str, claim: dict) -> str:
-    from vic_drake.analysis.claims import NOT_EVALUATED, claim_status
+    from vic_drake.analysis.claims import FAIL, NOT_EVALUATED, claim_status
+    from vic_drake.analysis.claims.reasons import fail_reasons
 
     status = claim_status(claim)
     line = f"  {cid}: {status.upper():<13} {claim['statement']}"
@@ -93,6 +94,9 @@ def _claim_line(cid: str, claim: dict) -> str:
             if "not evaluated" in p
         ]
         line += f"\n      ({'; '.join(reasons) or 'no reason recorded'})"
+    elif status == FAIL:
+        for reason in fail_reasons(cid, claim) or ["no reason recorded"]:
+            line += f"\n      ({reason})"
     return line
 
 
