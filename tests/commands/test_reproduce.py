@@ -56,6 +56,24 @@ def test_meshcat_live_view_prints_its_url_and_stops_on_ctrl_c(
     assert "Meshcat stopped" in err
 
 
+def _help(capsys) -> str:
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["reproduce", "--help"])
+    return " ".join(capsys.readouterr().out.split())
+
+
+def test_help_names_the_stages_and_the_quick_runs_time(capsys):
+    from vic_drake.reproduce import STAGE_NAMES
+
+    text = _help(capsys).split("options:", 1)[1]
+    stages_help = text.split("--stages LIST", 1)[1].split("--overwrite", 1)[0]
+    for name in STAGE_NAMES:
+        assert name in stages_help, name
+    quick_help = text.split("--quick", 1)[1].split("--phantom", 1)[0]
+    assert "5 minutes" not in quick_help and "half a minute" in quick_help
+    assert "--overwrite" in text
+
+
 def test_claim_lines_give_the_reason_of_a_fail():
     """Issue: the console printed "C2: FAIL" with no reason (only in the report)."""
     from vic_drake.commands.reproduce import _claim_line
