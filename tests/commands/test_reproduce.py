@@ -54,3 +54,75 @@ def test_meshcat_live_view_prints_its_url_and_stops_on_ctrl_c(
     err = capsys.readouterr().err
     assert f"live at {meshcat.web_url()}" in err and "Ctrl-C" in err
     assert "Meshcat stopped" in err
+
+
+def _help(capsys) -> str:
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["reproduce", "--help"])
+    return " ".join(capsys.readouterr().out.split())
+
+
+def test_help_names_the_stages_and_the_quick_runs_time(capsys):
+    from vic_drake.reproduce import STAGE_NAMES
+
+    text = _help(capsys).split("options:", 1)[1]
+    stages_help = text.split("--stages LIST", 1)[1].split("--overwrite", 1)[0]
+    for name in STAGE_NAMES:
+        assert name in stages_help, name
+    quick_help = text.split("--quick", 1)[1].split("--phantom", 1)[0]
+    assert "5 minutes" not in quick_help and "half a minute" in quick_help
+    assert "--overwrite" in text
+
+
+def test_claim_lines_give_the_reason_of_a_fail():
+    """Issue: the console printed "C2: FAIL" with no reason (only in the report)."""
+    from vic_drake.commands.reproduce import _claim_line
+
+    curve = {"tau_s": 7.4, "a": 0.15, "c": 0.03, "spearman": -1.0, "n_points": 48}
+    c2 = {
+        "statement": "The fit residual falls about exponentially",
+        "sim": {"sim_2.5hz": {**curve, "r2": 0.99, "ratio_last_first": 0.61}},
+        "real": {
+            "test_soft_1hz": {
+                **curve,
+                "r2": 0.97,
+                "ratio_last_first": 0.13,
+                "pass": True,
+            },
+            "test_soft_25hz": {
+                **curve,
+                "r2": 0.257,
+                "spearman": -0.81,
+                "ratio_last_first": 0.26,
+                "pass": False,
+            },
+        },
+        "pass": False,
+        "status": "fail",
+        "pass_sim": True,
+        "pass_real": False,
+        "detail": "fit r(T)=c+a exp(-T/tau); pass: spearman <= -0.8, R^2 >= 0.9",
+    }
+    line = _claim_line("C2", c2)
+    assert "FAIL" in line
+    assert "real logs: test_soft_25hz misses R^2 0.26 (needs >= 0.9)" in line
+    assert "test_soft_1hz" not in line and "simulation" not in line
+    # A flat side: its values and the claim's pass criterion.
+    c4 = {
+        "statement": "VS-CF tracks its force reference about as well as CF",
+        "sim": {"rmse_ratio": 1.35, "vs_cf_lifted_off": True},
+        "real": None,
+        "pass": False,
+        "status": "fail",
+        "pass_sim": False,
+        "pass_real": None,
+        "detail": "RMSE of pressing force; pass: ratio <= 1.2",
+    }
+    line = _claim_line("C4", c4)
+    assert (
+        "(simulation: rmse_ratio 1.35, vs_cf_lifted_off true; pass: ratio <= 1.2)"
+        in line
+    )
+    # Failed checks are named.
+    c7 = {**c4, "sim": {"tank_min_J": 0.3, "checks": {"tank_above_min": False}}}
+    assert "check(s) tank_above_min fail" in _claim_line("C7", c7)

@@ -11,3 +11,19 @@ def test_reproduce_does_not_import_the_commands():
         "assert not bad, bad\n"
     )
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+def test_the_command_line_parser_does_not_import_the_pipeline():
+    """The reproduce help names the stages without importing the pipeline
+    (vic_drake.reproduce imports its names on first use)."""
+    code = (
+        "import sys\n"
+        "from vic_drake.cli import build_parser\n"
+        "build_parser()\n"
+        "bad = sorted(m for m in sys.modules if m.startswith('vic_drake.reproduce.')\n"
+        "             and m != 'vic_drake.reproduce.stage_names')\n"
+        "assert not bad, bad\n"
+        "import vic_drake.reproduce as r\n"
+        "assert r.reproduce is r.pipeline.reproduce and 'scan_scenario' in dir(r)\n"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True)

@@ -39,3 +39,33 @@ def test_cli_bad_relaxation_is_a_clean_error(tmp_path, capsys):
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert "--relaxation takes G:TAU pairs" in err and "Traceback" not in err
+
+
+def test_an_empty_stage_list_is_an_error_naming_the_stages(
+    tmp_path, capsys, monkeypatch
+):
+    """Issue: `--stages ""` ran every stage."""
+    import vic_drake.reproduce.pipeline as pipeline
+    from vic_drake.reproduce import STAGE_NAMES
+
+    with pytest.raises(VicDrakeError, match="no stage given") as err:
+        ReproduceOptions(out_dir=tmp_path, stages=())
+    assert all(name in str(err.value) for name in STAGE_NAMES)
+    ran = []
+    monkeypatch.setattr(
+        pipeline,
+        "STAGES",
+        tuple((n, lambda ctx, n=n: ran.append(n)) for n in STAGE_NAMES),
+    )
+    for empty in ("", " , "):
+        out = tmp_path / "out"
+        assert main(["reproduce", "--out", str(out), "--stages", empty]) == 2
+        err = capsys.readouterr().err
+        assert "no stage given" in err and "offline_real, offline_sim" in err
+        assert not ran and not out.exists()
+
+
+def test_stage_names_are_the_pipelines():
+    from vic_drake.reproduce import STAGE_NAMES, STAGES
+
+    assert tuple(name for name, _ in STAGES) == STAGE_NAMES

@@ -86,3 +86,29 @@ def test_bad_file_names_the_file(tmp_path):
 def test_dump_needs_a_scenario():
     with pytest.raises(VicDrakeError, match="needs a Scenario"):
         dumps_scenario(TrajectoryConfig())
+
+
+def test_another_kind_of_vic_drake_yaml_is_named(tmp_path):
+    """A palpation log's settings (written by reproduce) or a campaign spec
+    given to the scenario loader is named as such, not as unknown fields."""
+    import pandas as pd
+
+    from vic_drake.experiments.campaign_params import CampaignParams
+    from vic_drake.paths import PROJECT_ROOT
+    from vic_drake.reproduce import ReproduceOptions, RunContext
+    from vic_drake.reproduce.context import _write_log
+
+    ctx = RunContext(ReproduceOptions(out_dir=tmp_path))
+    config = {"campaign_params": CampaignParams(), "phantom": "synthetic", "seed": 0}
+    _write_log(ctx, "palpation_sim_2.5hz", pd.DataFrame({"t_s": [0.0]}), config)
+    path = tmp_path / "logs" / "palpation_sim_2.5hz.yaml"
+    with pytest.raises(VicDrakeError) as err:
+        load_scenario(path)
+    msg = str(err.value)
+    assert "palpation_sim_2.5hz.yaml" in msg and "not a scan scenario" in msg
+    assert "palpation campaign's settings" in msg and "unknown" not in msg
+    with pytest.raises(VicDrakeError, match="campaign spec; run it with vic-drake"):
+        load_scenario(PROJECT_ROOT / "campaigns" / "smoke.yaml")
+    # A scenario with a misspelt field still gets the field error.
+    with pytest.raises(VicDrakeError, match="duraton_s is unknown"):
+        loads_scenario("duraton_s: 3\n")

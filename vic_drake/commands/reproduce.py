@@ -13,6 +13,7 @@ from vic_drake.commands.common import (
     emit,
     parse_relaxation,
 )
+from vic_drake.reproduce.stage_names import STAGE_NAMES
 
 #: Exit statuses of ``vic-drake reproduce`` (documented in its --help).
 EXIT_ALL_PASS, EXIT_CLAIMS_NOT_ALL_PASS = 0, 1
@@ -22,7 +23,9 @@ _EPILOG = (
     "not evaluated (e.g. a stage failed or was not selected with --stages), unless "
     "--allow-fail; 2 on bad input (nothing is simulated); 130 when interrupted "
     "(Ctrl-C). Outputs are written to a work folder beside OUT and moved to OUT "
-    'only when the run finishes; OUT/run.json says "complete": true.'
+    'only when the run finishes; OUT/run.json says "complete": true. A previous '
+    "run in OUT is replaced only by a run that covers it (every stage that ran "
+    "there, and the data if it had it), else with --overwrite."
 )
 
 
@@ -41,7 +44,8 @@ def register(subparsers) -> None:
     parser.add_argument(
         "--quick",
         action="store_true",
-        help="shorter scans and a coarser map (under 5 minutes on 2 cores)",
+        help="shorter scans and a coarser map (about half a minute on a 2-core "
+        "machine, longer when it is busy)",
     )
     parser.add_argument(
         "--phantom",
@@ -54,7 +58,15 @@ def register(subparsers) -> None:
         "--stages",
         default=None,
         metavar="LIST",
-        help="comma-separated stages to run (default: all)",
+        help="comma-separated stages to run, of: "
+        f"{', '.join(STAGE_NAMES)} (default: all; they run in this order)",
+    )
+    parser.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace the previous run in OUT even when this run does not cover "
+        "it (a --stages subset, or no data where it had the data); never a folder "
+        "that is not a run",
     )
     parser.add_argument(
         "--allow-fail",
@@ -82,7 +94,8 @@ def register(subparsers) -> None:
 
 
 def _claim_line(cid: str, claim: dict) -> str:
-    from vic_drake.analysis.claims import NOT_EVALUATED, claim_status
+    from vic_drake.analysis.claims import FAIL, NOT_EVALUATED, claim_status
+    from vic_drake.analysis.claims.reasons import fail_reasons
 
     status = claim_status(claim)
     line = f"  {cid}: {status.upper():<13} {claim['statement']}"
@@ -93,6 +106,9 @@ def _claim_line(cid: str, claim: dict) -> str:
             if "not evaluated" in p
         ]
         line += f"\n      ({'; '.join(reasons) or 'no reason recorded'})"
+    elif status == FAIL:
+        for reason in fail_reasons(cid, claim) or ["no reason recorded"]:
+            line += f"\n      ({reason})"
     return line
 
 
@@ -118,7 +134,7 @@ def _run(args: argparse.Namespace) -> int:
     from vic_drake.reproduce import ReproduceOptions, reproduce
 
     stages = None
-    if args.stages:
+    if args.stages is not None:  # An empty list is an error (options).
         stages = tuple(s.strip() for s in args.stages.split(",") if s.strip())
     progress = Progress(enabled=not (args.quiet or args.json))
     options = ReproduceOptions(
@@ -128,6 +144,7 @@ def _run(args: argparse.Namespace) -> int:
         phantom=args.phantom,
         stages=stages,
         meshcat=args.meshcat,
+        overwrite=args.overwrite,
         progress=progress,
         relaxation=None
         if args.relaxation is None

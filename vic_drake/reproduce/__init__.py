@@ -30,46 +30,50 @@ Stages (see :data:`STAGES`):
 
 :func:`reproduce` is the library entry point; ``vic-drake reproduce`` is a
 thin wrapper.
+
+The names below are imported on first use (PEP 562), so that importing a
+light submodule (:mod:`~vic_drake.reproduce.stage_names`, for the command
+line's help) does not import the pipeline, pandas and pyarrow.
 """
 
-from vic_drake.paper import CONTROLLERS, DISTURBANCE_CONTROLLERS
-from vic_drake.reproduce.context import RunContext, StageRecord, StageSkipped
-from vic_drake.reproduce.options import ReproduceOptions
-from vic_drake.reproduce.pipeline import (
-    STAGE_NAMES,
-    STAGES,
-    ReproduceResult,
-    reproduce,
-    run_pipeline,
-)
-from vic_drake.reproduce.stages.claims import gather_claim_inputs
-from vic_drake.reproduce.stages.real_scans import (
-    REAL_CF_REFERENCE_N,
-    REAL_LIMITS,
-    REAL_SCAN_LOGS,
-    real_scan_frame,
-)
-from vic_drake.reproduce.stages.replay import replay_scan
-from vic_drake.reproduce.stages.scans import scan_limits, scan_scenario
+from __future__ import annotations
 
-__all__ = [
-    "CONTROLLERS",
-    "DISTURBANCE_CONTROLLERS",
-    "REAL_CF_REFERENCE_N",
-    "REAL_LIMITS",
-    "REAL_SCAN_LOGS",
-    "ReproduceOptions",
-    "ReproduceResult",
-    "RunContext",
-    "STAGES",
-    "STAGE_NAMES",
-    "StageRecord",
-    "StageSkipped",
-    "gather_claim_inputs",
-    "real_scan_frame",
-    "replay_scan",
-    "reproduce",
-    "run_pipeline",
-    "scan_limits",
-    "scan_scenario",
-]
+import importlib
+
+#: Public name -> the module that defines it.
+_EXPORTS = {
+    "CONTROLLERS": "vic_drake.paper",
+    "DISTURBANCE_CONTROLLERS": "vic_drake.paper",
+    "RunContext": "vic_drake.reproduce.context",
+    "StageRecord": "vic_drake.reproduce.context",
+    "StageSkipped": "vic_drake.reproduce.context",
+    "ReproduceOptions": "vic_drake.reproduce.options",
+    "STAGE_NAMES": "vic_drake.reproduce.stage_names",
+    "STAGES": "vic_drake.reproduce.pipeline",
+    "ReproduceResult": "vic_drake.reproduce.pipeline",
+    "reproduce": "vic_drake.reproduce.pipeline",
+    "run_pipeline": "vic_drake.reproduce.pipeline",
+    "gather_claim_inputs": "vic_drake.reproduce.stages.claims",
+    "REAL_CF_REFERENCE_N": "vic_drake.reproduce.stages.real_scans",
+    "REAL_LIMITS": "vic_drake.reproduce.stages.real_scans",
+    "REAL_SCAN_LOGS": "vic_drake.reproduce.stages.real_scans",
+    "real_scan_frame": "vic_drake.reproduce.stages.real_scans",
+    "replay_scan": "vic_drake.reproduce.stages.replay",
+    "scan_limits": "vic_drake.reproduce.stages.scans",
+    "scan_scenario": "vic_drake.reproduce.stages.scans",
+}
+
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name: str):
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value  # Imported once.
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_EXPORTS})

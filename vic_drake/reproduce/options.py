@@ -8,6 +8,7 @@ from pathlib import Path
 
 from vic_drake.errors import VicDrakeError
 from vic_drake.paths import check_data_dir, has_data, resolve_data_dir
+from vic_drake.reproduce.stage_names import STAGE_NAMES
 from vic_drake.tissue.relaxation import RelaxationParams
 
 
@@ -29,6 +30,10 @@ class ReproduceOptions:
         relaxation: the relaxing tissue's branches in every simulation of the
             run (palpations, scans, compare-real); None (the default):
             :data:`vic_drake.tissue.DEFAULT_RELAXATION`.
+        overwrite: replace a previous complete run in ``out_dir`` even when
+            this run does not cover it (fewer stages, or no data where it had
+            the data); without it such a run is refused before any work
+            (:func:`vic_drake.reproduce.run_dir.check_replace`).
     """
 
     out_dir: Path
@@ -39,6 +44,7 @@ class ReproduceOptions:
     meshcat: bool = False
     progress: Callable[[str], None] = lambda message: None
     relaxation: RelaxationParams | None = None
+    overwrite: bool = False
 
     def __post_init__(self):
         self.out_dir = Path(self.out_dir)
@@ -61,10 +67,12 @@ class ReproduceOptions:
                 "VIC_DRAKE_DATA)"
             )
         if self.stages is not None:
-            # Function-local: import cycle (the pipeline's stages take a
-            # RunContext, which holds these options).
-            from vic_drake.reproduce.pipeline import STAGE_NAMES
-
+            self.stages = tuple(self.stages)
+            if not self.stages:
+                raise VicDrakeError(
+                    "no stage given (--stages is empty); give one or more of "
+                    f"{', '.join(STAGE_NAMES)}, or omit it to run them all"
+                )
             unknown = [s for s in self.stages if s not in STAGE_NAMES]
             if unknown:
                 raise VicDrakeError(

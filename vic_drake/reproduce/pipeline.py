@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from vic_drake.analysis.claims import PASS, claim_status
+from vic_drake.paths import find_data_dir
 from vic_drake.reproduce.context import RunContext, StageRecord, StageSkipped
 from vic_drake.reproduce.interrupt import interrupted, sigint_watch
 from vic_drake.reproduce.options import ReproduceOptions
@@ -32,6 +33,8 @@ from vic_drake.reproduce.stages.replay import stage_replay
 from vic_drake.reproduce.stages.report import stage_report
 from vic_drake.reproduce.stages.scans import stage_scans
 
+#: The stages in run order; their names are
+#: :data:`vic_drake.reproduce.stage_names.STAGE_NAMES`.
 STAGES: tuple[tuple[str, Callable[[RunContext], Any]], ...] = (
     ("offline_real", stage_offline_real),
     ("offline_sim", stage_offline_sim),
@@ -44,7 +47,6 @@ STAGES: tuple[tuple[str, Callable[[RunContext], Any]], ...] = (
     ("claims", stage_claims),
     ("report", stage_report),
 )
-STAGE_NAMES = tuple(name for name, _ in STAGES)
 
 
 @dataclass
@@ -114,13 +116,21 @@ def reproduce(options: ReproduceOptions) -> ReproduceResult:
     The outputs are written through a work folder and moved to
     ``options.out_dir`` only when every selected stage has run
     (:mod:`vic_drake.reproduce.run_dir`); an interrupted run leaves the
-    previous run in ``out_dir`` whole.
+    previous run in ``out_dir`` whole. A previous complete run there is
+    replaced only by a run that covers it (every stage that ran there, the
+    data if it had it) or with ``options.overwrite``.
 
     Raises:
-        VicDrakeError: the output folder cannot be used (checked before any
-            work).
+        VicDrakeError: the output folder cannot be used, or holds a complete
+            run that this one does not cover (checked before any work).
     """
-    work = prepare_run_dir(options.out_dir)
+    data_dir = find_data_dir(options.data_dir)
+    work = prepare_run_dir(
+        options.out_dir,
+        stages=options.stages,
+        data_dir=data_dir,
+        overwrite=options.overwrite,
+    )
     ctx = RunContext(options, work_dir=work)
     t0 = time.perf_counter()
     try:
@@ -139,6 +149,7 @@ def reproduce(options: ReproduceOptions) -> ReproduceResult:
         options.out_dir,
         wall_s=round(wall, 2),
         quick=options.quick,
+        data_dir=None if data_dir is None else str(data_dir),
         stages=[r.as_dict() for r in ctx.records],
         claims={k: claim_status(v) for k, v in claims.items()},
     )

@@ -5,7 +5,9 @@ field by field from the real annotations of the config dataclasses; fields
 missing from the file keep their defaults. ``__post_init__`` only ever saw
 those defaults, so :meth:`Scenario.validate` runs on what was loaded. Errors
 never surface as tracebacks: each is a :class:`VicDrakeError` naming the file
-(or "scenario YAML"), the field path and the bad value.
+(or "scenario YAML"), the field path and the bad value. A YAML of another
+kind that vic_drake writes or reads (a palpation campaign's settings, a
+campaign spec) is named as such, by its top-level key (:data:`OTHER_FILES`).
 """
 
 import dataclasses
@@ -19,6 +21,17 @@ from pydrake.common.yaml import yaml_dump_typed, yaml_load, yaml_load_typed
 from vic_drake.errors import VicDrakeError
 from vic_drake.paths import check_input_file
 from vic_drake.scenario.scenario import Scenario
+
+#: Top-level keys of the other YAMLs of vic_drake -> what such a file is.
+OTHER_FILES = {
+    "campaign_params": (
+        "a palpation campaign's settings, which vic-drake reproduce writes beside "
+        "its palpation and map logs; a run's scan scenarios are its "
+        "logs/nominal_*.yaml and logs/disturbance_*.yaml"
+    ),
+    "factors": "a campaign spec; run it with vic-drake campaign FILE --out DIR",
+    "base_scenario": "a campaign spec; run it with vic-drake campaign FILE --out DIR",
+}
 
 
 def load_scenario(path: str | os.PathLike) -> Scenario:
@@ -47,24 +60,27 @@ def _load(source: dict, where: str) -> Scenario:
         raise VicDrakeError(f"{where}: {exc}") from None
     except Exception as exc:
         # Drake's loader raises RuntimeError, ValueError or yaml errors.
-        raise VicDrakeError(
-            f"{where}: {_locate_error(source, exc)} "
-            "(the fields and types are those of vic_drake.scenario.Scenario)"
-        ) from None
+        raise VicDrakeError(f"{where}: {_explain(source, exc)}") from None
     try:
         return scenario.validate()
     except (VicDrakeError, TypeError, ValueError) as exc:
         raise VicDrakeError(f"{where}: {exc}") from None
 
 
-def _locate_error(source: dict, exc: Exception) -> str:
-    """Names the field path of an error the Drake loader reported without one."""
+def _explain(source: dict, exc: Exception) -> str:
+    """What is wrong: another kind of file, or the field path of the error
+    (the Drake loader reports it without one)."""
     try:
         raw = yaml_load(**source)
     except Exception:
         return str(exc)
+    if isinstance(raw, dict):
+        for key, kind in OTHER_FILES.items():
+            if key in raw:
+                return f"not a scan scenario: its top-level key {key!r} marks {kind}"
     path = _first_bad_field(raw, Scenario, "")
-    return f"field {path}" if path else f"{type(exc).__name__}: {exc}"
+    what = f"field {path}" if path else f"{type(exc).__name__}: {exc}"
+    return f"{what} (the fields and types are those of vic_drake.scenario.Scenario)"
 
 
 def _record_types(tp) -> dict | None:

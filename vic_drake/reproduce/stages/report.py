@@ -8,11 +8,8 @@ import os
 import platform
 import time
 
-from vic_drake.analysis.claims.thresholds import (
-    C2_MAX_RATIO,
-    C2_MAX_SPEARMAN,
-    C2_MIN_R2,
-)
+from vic_drake.analysis.claims.reasons import c2_misses
+from vic_drake.analysis.claims.thresholds import C2_MAX_RATIO, C2_MIN_R2
 from vic_drake.reproduce.context import RunContext
 from vic_drake.reproduce.report import ReportContent, write_report
 
@@ -115,7 +112,7 @@ def _offline_sim_notes(ctx: RunContext, claims: dict, *, real: bool) -> list[str
             "C2 in simulation fails on this run's relaxing tissue: ratio "
             f"{', '.join(f'{r:.2f}' for r in ratios)} (needs at most {C2_MAX_RATIO:g})."
         )
-    failing = _c2_failures((claims.get("C2") or {}).get("real"))
+    failing = c2_misses((claims.get("C2") or {}).get("real"))
     if failing:
         notes.append(
             "C2 in the real logs holds only where every log shows the decay; "
@@ -123,31 +120,6 @@ def _offline_sim_notes(ctx: RunContext, claims: dict, *, real: bool) -> list[str
             + "."
         )
     return notes
-
-
-def _c2_failures(per_log) -> list[str]:
-    """'log: what it misses' for each log that fails C2's criteria."""
-    if not isinstance(per_log, dict):
-        return []
-    out = []
-    for name, d in per_log.items():
-        if not isinstance(d, dict) or d.get("pass") is not False:
-            continue
-        missed = []
-        if not d["r2"] >= C2_MIN_R2:
-            missed.append(f"R^2 {d['r2']:.2f} (needs >= {C2_MIN_R2:g})")
-        if not d["spearman"] <= C2_MAX_SPEARMAN:
-            missed.append(
-                f"Spearman {d['spearman']:.2f} (needs <= {C2_MAX_SPEARMAN:g})"
-            )
-        if not d["ratio_last_first"] <= C2_MAX_RATIO:
-            missed.append(
-                f"last/first {d['ratio_last_first']:.2f} (needs <= {C2_MAX_RATIO:g})"
-            )
-        if not d["a"] > 0:
-            missed.append("no falling amplitude")
-        out.append(f"{name} misses {', '.join(missed) or 'a criterion'}")
-    return out
 
 
 _PAPER_ORDER = (
