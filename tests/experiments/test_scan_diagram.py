@@ -89,8 +89,11 @@ def test_controller_reads_the_map_with_its_own_lookup():
     tissue = GridPhantom(x_m=xs, y_m=ys, z_m=np.zeros((2, 2)), kappa=grid, lam=grid)
     tissue.point_lookup()  # The tissue's (bilinear) fast lookup is cached first.
     scenario = replace(
-        synthetic_scenario("vs-vf"), phantom=PhantomConfig(kind="measured")
+        synthetic_scenario("vs-vf"),
+        phantom=PhantomConfig(kind="measured", controller_lookup="nearest"),
     )
     ctrl = _controller_phantom(scenario, tissue)
     assert ctrl.point_lookup()(0.004, 0.001)[3] == pytest.approx(1000.0)  # Nearest.
     assert tissue.point_lookup()(0.004, 0.001)[3] == pytest.approx(1900.0)  # Bilinear.
+    # The default: bilinear, as the real controller's logs show.
+    assert PhantomConfig(kind="measured").controller_lookup == "bilinear"

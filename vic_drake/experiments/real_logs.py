@@ -447,7 +447,7 @@ def scenario_from_real_log(
         name=name,
         description=description + tail,
         phantom=PhantomConfig(
-            kind="measured", lookup="bilinear", controller_lookup="nearest"
+            kind="measured", lookup="bilinear", controller_lookup="bilinear"
         ),
         controller=ctrl,
         fdcc=fdcc,

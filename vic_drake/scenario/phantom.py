@@ -19,13 +19,15 @@ class PhantomConfig:
         lookup: how the *tissue* (the station's force element) reads the
             measured map: "bilinear" (a smooth body) or "nearest".
         controller_lookup: how the *controller* reads the map (surface,
-            kappa, lambda for its references): "nearest", what the real
-            controller did, or "bilinear".
+            kappa, lambda for its references): "bilinear", what the real
+            controller's logs show (docs/decisions.md, "The controller reads
+            the map bilinearly"), or "nearest" (the grid point, as the data
+            README describes the published source).
     """
 
     kind: str = "synthetic"  # "synthetic" | "measured".
     lookup: str = "bilinear"  # Tissue lookup on the measured map.
-    controller_lookup: str = "nearest"  # The controller's lookup on the measured map.
+    controller_lookup: str = "bilinear"  # The controller's lookup on the measured map.
 
     def __post_init__(self):
         self.validate()

@@ -5,8 +5,8 @@ tissue surface height z(x, y), its gradient, and the Hunt-Crossley
 parameters kappa(x, y), lambda(x, y) for one exponent beta. Two kinds:
 
 - :class:`GridPhantom`: a map on a regular grid, e.g. the paper's measured
-  GP map (``phantom_map/``). Bilinear lookup (or nearest, as the real
-  controller did). Outside the grid a query is clamped to the nearest grid
+  GP map (``phantom_map/``). Bilinear lookup (as the real controller's
+  logs show) or nearest. Outside the grid a query is clamped to the nearest grid
   edge: values extend constantly and the gradient across the edge is zero.
 - :class:`SyntheticChestPhantom`: an analytic chest (torso, curvature,
   shoulder rise, ribs as stiff bands, one rib under muscle), the embedded

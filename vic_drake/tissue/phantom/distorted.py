@@ -66,7 +66,7 @@ def with_map_errors(
     """The phantom as a map with these errors; the phantom itself when none.
 
     A :class:`GridPhantom` stays a grid (same lookup, axes shifted, grids
-    scaled), so the controller's nearest-point lookup is kept; any other
+    scaled), so the controller's lookup is kept; any other
     phantom is wrapped in a :class:`DistortedPhantom`.
     """
     errors = (kappa_scale, lam_scale, surface_offset_m, shift_x_m, shift_y_m)

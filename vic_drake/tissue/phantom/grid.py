@@ -1,6 +1,6 @@
 """A phantom given on a regular (x, y) grid, such as the paper's measured GP map.
 
-Bilinear lookup (or nearest, as the real controller did). Outside the grid a
+Bilinear lookup (as the real controller's logs show) or nearest. Outside the grid a
 query is clamped to the nearest grid edge: values extend constantly and the
 gradient across the edge is zero.
 """
@@ -34,7 +34,8 @@ class GridPhantom(Phantom):
         beta: their exponent.
         surface_offset_m: added to z_m to give the tissue surface (the real
             controller used +0.0025 m on the measured map).
-        lookup: "bilinear" (default) or "nearest" (what the real controller did).
+        lookup: "bilinear" (default; what the real controller's logs show) or
+            "nearest".
         name: label.
     """
 
