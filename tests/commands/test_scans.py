@@ -261,16 +261,22 @@ def test_scan_of_a_folder_or_a_bare_name(tmp_path, monkeypatch, capsys):
     assert "did you mean diagrams/nominal_vs_vf_synthetic.yaml" in err
 
 
-@pytest.mark.realdata
-def test_compare_real_refuses_settings_the_controller_does_not_have(
-    data_dir, monkeypatch, capsys
-):
+@pytest.fixture
+def tracking5_without_simulation(data_dir, monkeypatch):
+    """test_tracking5's path, with compare-real's simulation made to fail."""
     import importlib
 
     # The module (vic_drake.experiments.compare_real is also the function).
     module = importlib.import_module("vic_drake.experiments.compare_real")
     monkeypatch.setattr(module, "run_scan", _no_simulation)
-    bag = str(data_dir / "experiments" / "test_tracking5")
+    return str(data_dir / "experiments" / "test_tracking5")
+
+
+@pytest.mark.realdata
+def test_compare_real_refuses_settings_the_controller_does_not_have(
+    tracking5_without_simulation, capsys
+):
+    bag = tracking5_without_simulation
     assert main(["compare-real", bag, "--stiffness", "400"]) == 2
     err = capsys.readouterr().err
     assert "--stiffness applies to CS; this log was identified as vs-cf" in err
@@ -282,14 +288,9 @@ def test_compare_real_refuses_settings_the_controller_does_not_have(
 
 @pytest.mark.realdata
 def test_compare_real_refuses_a_duration_short_of_the_contact_window(
-    data_dir, monkeypatch, capsys
+    tracking5_without_simulation, capsys
 ):
-    import importlib
-
-    # The module (vic_drake.experiments.compare_real is also the function).
-    module = importlib.import_module("vic_drake.experiments.compare_real")
-    monkeypatch.setattr(module, "run_scan", _no_simulation)
-    bag = str(data_dir / "experiments" / "test_tracking5")
+    bag = tracking5_without_simulation
     assert main(["compare-real", bag, "--duration", "0.5"]) == 2
     err = capsys.readouterr().err
     assert "duration 0.5 s ends before the real log's contact window" in err

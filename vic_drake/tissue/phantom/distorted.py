@@ -124,16 +124,22 @@ def with_surface_profile(phantom: Phantom, x_m, offsets_m) -> GridPhantom:
             f"increasing in x; got x_m={x_m!r}, offsets_m={offsets_m!r}"
         )
     raise_x = np.interp(phantom.x_m, xs, offs)
+    return _raised(phantom, raise_x[:, None], "surface profile")
+
+
+def _raised(phantom: GridPhantom, raise_m, label: str) -> GridPhantom:
+    """``phantom`` with its surface raised by ``raise_m`` (broadcast on its
+    grid); kappa, lambda, beta and the lookup are kept."""
     return GridPhantom(
         x_m=phantom.x_m,
         y_m=phantom.y_m,
-        z_m=phantom.surface_m - phantom.surface_offset_m + raise_x[:, None],
+        z_m=phantom.surface_m - phantom.surface_offset_m + raise_m,
         kappa=phantom.kappa_grid,
         lam=phantom.lam_grid,
         beta=phantom.beta,
         surface_offset_m=phantom.surface_offset_m,
         lookup=phantom.lookup,
-        name=f"{phantom.name} (surface profile)",
+        name=f"{phantom.name} ({label})",
     )
 
 
@@ -174,17 +180,7 @@ def with_surface_plane(
         + g[0] * (phantom.x_m[:, None] - o[0])
         + g[1] * (phantom.y_m[None, :] - o[1])
     )
-    return GridPhantom(
-        x_m=phantom.x_m,
-        y_m=phantom.y_m,
-        z_m=phantom.surface_m - phantom.surface_offset_m + raise_xy,
-        kappa=phantom.kappa_grid,
-        lam=phantom.lam_grid,
-        beta=phantom.beta,
-        surface_offset_m=phantom.surface_offset_m,
-        lookup=phantom.lookup,
-        name=f"{phantom.name} (surface plane)",
-    )
+    return _raised(phantom, raise_xy, "surface plane")
 
 
 __all__ = [
