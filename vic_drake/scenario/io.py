@@ -42,29 +42,53 @@ def loads_scenario(text: str) -> Scenario:
 
 def _load(source: dict, where: str) -> Scenario:
     """yaml_load_typed on one source (``filename=`` or ``data=``), then validate."""
-    try:
-        scenario = yaml_load_typed(schema=Scenario, **source)
-    except VicDrakeError as exc:
-        raise VicDrakeError(f"{where}: {exc}") from None
-    except Exception as exc:
-        # Drake's loader raises RuntimeError, ValueError or yaml errors.
-        raise VicDrakeError(
-            f"{where}: {_locate_error(source, exc)} "
-            "(the fields and types are those of vic_drake.scenario.Scenario)"
-        ) from None
+    scenario = load_typed(
+        Scenario, source, where, schema_name="vic_drake.scenario.Scenario"
+    )
     try:
         return scenario.validate()
     except (VicDrakeError, TypeError, ValueError) as exc:
         raise VicDrakeError(f"{where}: {exc}") from None
 
 
-def _locate_error(source: dict, exc: Exception) -> str:
+def load_typed(schema: type, source: dict, where: str, *, schema_name: str):
+    """``yaml_load_typed`` of a config dataclass, its errors naming the field.
+
+    Drake's loader reports some errors without the field (a wrong scalar:
+    "invalid literal for int()") and unknown fields without the allowed
+    ones; this names the field path, the bad value and, for an unknown
+    field, the allowed names. Used for scenarios and campaign specs.
+
+    Args:
+        schema: the dataclass to load (its fields are filled from the file).
+        source: ``{"filename": path}`` or ``{"data": text}``.
+        where: what the messages start with, e.g. "scenario file 'x.yaml'".
+        schema_name: the type named in the message, e.g.
+            "vic_drake.scenario.Scenario".
+
+    Raises:
+        VicDrakeError: "{where}: {field and problem} (the fields and types
+            are those of {schema_name})".
+    """
+    try:
+        return yaml_load_typed(schema=schema, **source)
+    except VicDrakeError as exc:
+        raise VicDrakeError(f"{where}: {exc}") from None
+    except Exception as exc:
+        # Drake's loader raises RuntimeError, ValueError or yaml errors.
+        raise VicDrakeError(
+            f"{where}: {_locate_error(source, exc, schema)} "
+            f"(the fields and types are those of {schema_name})"
+        ) from None
+
+
+def _locate_error(source: dict, exc: Exception, schema: type) -> str:
     """Names the field path of an error the Drake loader reported without one."""
     try:
         raw = yaml_load(**source)
     except Exception:
         return str(exc)
-    path = _first_bad_field(raw, Scenario, "")
+    path = _first_bad_field(raw, schema, "")
     return f"field {path}" if path else f"{type(exc).__name__}: {exc}"
 
 
@@ -117,7 +141,8 @@ def _first_bad_field(value, tp, path: str) -> str | None:
             tp is not bool and isinstance(value, bool)
         )
         if not ok:
-            return f"{path} must be a {tp.__name__}; got {value!r}"
+            article = "an" if tp is int else "a"
+            return f"{path} must be {article} {tp.__name__}; got {value!r}"
     return None
 
 
