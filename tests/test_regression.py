@@ -88,6 +88,8 @@ def compare_to_golden(case: str, metrics: dict, tolerances: dict) -> None:
             moved.append(f"{name}: missing from the new run")
             continue
         new, old = metrics[name], g["value"]
+        if isinstance(new, float) and math.isnan(new):
+            new = None  # No value (e.g. the tank of CS and CF): null in the golden.
         if isinstance(old, bool) or isinstance(new, bool):
             if bool(new) != bool(old):
                 moved.append(f"{name}: {old} -> {new}")
@@ -110,7 +112,7 @@ def _plain(v):
         return bool(v)
     if isinstance(v, (np.integer, int)):
         return int(v)
-    if v is None:
+    if v is None or math.isnan(v):
         return None
     return float(v)
 

@@ -43,8 +43,15 @@ def peak_force_N(df: pd.DataFrame) -> float:
     return float(np.nanmax(pressing_force_N(df)))
 
 
-def tank_min_J(df: pd.DataFrame) -> float:
-    """Lowest tank energy of the run, J (NaN if the tank is not logged)."""
+def tank_min_J(df: pd.DataFrame, *, has_tank: bool = True) -> float:
+    """Lowest tank energy of the run, J.
+
+    NaN if the tank is not logged, or if the controller has none
+    (``has_tank`` False: CS and CF, :func:`vic_drake.control.references.has_tank`;
+    their log holds the tank's initial energy throughout).
+    """
+    if not has_tank:
+        return float("nan")
     require_columns(df, "tank_energy_J")
     e = df["tank_energy_J"].to_numpy(float)
     return float(np.nanmin(e)) if np.isfinite(e).any() else float("nan")

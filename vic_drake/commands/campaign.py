@@ -4,12 +4,15 @@ Runs every run of a campaign spec (``campaigns/*.yaml``) on a local Dask
 cluster (``--workers N`` processes, default: the machine's cores) or on an
 existing one (``--scheduler tcp://host:port``), writes one row per run as it
 finishes, and the summary (``summary.html``, ``summary.json``,
-``results.parquet``). ``--resume`` finishes an interrupted campaign.
+``results.parquet``). ``--resume`` finishes an interrupted campaign (or
+starts it in a new or empty --out); a folder holding anything else is
+refused.
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 
 from vic_drake.commands.common import Progress, add_json_option, emit
 from vic_drake.errors import VicDrakeError
@@ -20,6 +23,7 @@ JSON_KEYS = (
     "finished",
     "failed",
     "nan_runs",
+    "session_runs",
     "wall_s",
     "runs_per_hour",
     "workers",
@@ -75,27 +79,48 @@ def register(subparsers) -> None:
         help="an existing Dask scheduler, e.g. tcp://10.0.0.5:8786",
     )
     p.add_argument(
-        "--resume", action="store_true", help="finish the campaign already in --out"
+        "--resume",
+        action="store_true",
+        help="finish the campaign already in --out (a new or empty --out: start it)",
     )
     add_json_option(p)
     p.set_defaults(handler=run_campaign_command)
 
 
+def _num(value: float, width: int, digits: int) -> str:
+    """A number of the console table; "-" where there is none (NaN: e.g. the
+    tank of CS and CF, which have none), as in the README's tables."""
+    text = "-" if value is None or math.isnan(value) else f"{value:.{digits}f}"
+    return f"{text:>{width}}"
+
+
 def _human(result: dict) -> str:
+    new = result["session_runs"]
+    before = result["finished"] - new
+    if new:
+        # The time and the rate are this session's: its runs alone.
+        session = (
+            f"this session {new} runs in {result['wall_s']:.0f} s on "
+            f"{result['workers']} workers, {result['runs_per_hour']:.0f} runs/h"
+        )
+        if before:
+            session += f" ({before} finished before)"
+    else:
+        session = "nothing left to run"
     lines = [
         f"{result['finished']}/{result['runs']} runs finished, {result['failed']} failed "
-        f"({result['nan_runs']} NaN), {result['wall_s']:.0f} s on {result['workers']} "
-        f"workers, {result['runs_per_hour']:.0f} runs/h",
+        f"({result['nan_runs']} NaN); {session}",
         f"{'controller':<10} {'runs':>5} {'peakF p50':>10} {'peakF max':>10} "
         f"{'P(exceed)':>10} {'95% CI':>16} {'loss p50 s':>10} {'tank min J':>10}",
     ]
     for name, v in result["per_controller"].items():
         lo, hi = v["exceed_prob_ci95"]
+        ci = f"[{_num(lo, 0, 3)}, {_num(hi, 0, 3)}]"
         lines.append(
-            f"{name:<10} {v['runs']:>5} {v['peak_force_N_p50']:>10.2f} "
-            f"{v['peak_force_N_max']:>10.2f} {v['exceed_prob']:>10.3f} "
-            f"{f'[{lo:.3f}, {hi:.3f}]':>16} {v['contact_loss_s_p50']:>10.3f} "
-            f"{v['tank_min_J']:>10.3f}"
+            f"{name:<10} {v['runs']:>5} {_num(v['peak_force_N_p50'], 10, 2)} "
+            f"{_num(v['peak_force_N_max'], 10, 2)} {_num(v['exceed_prob'], 10, 3)} "
+            f"{ci:>16} {_num(v['contact_loss_s_p50'], 10, 3)} "
+            f"{_num(v['tank_min_J'], 10, 3)}"
         )
     return "\n".join(lines)
 

@@ -193,6 +193,16 @@ def uses_qp(ref: ReferenceParams) -> bool:
     return ref.controller in ("vs-cf", "vs-vf")
 
 
+def has_tank(ref: ReferenceParams) -> bool:
+    """True for the controllers with an energy tank: VS-CF and VS-VF.
+
+    CS and CF run no QP and have no tank; their logged tank only holds its
+    initial energy (``tank_energy_J`` constant, ``tank_power_W`` 0), which
+    is not a tank figure: their tank metrics are NaN.
+    """
+    return uses_qp(ref)
+
+
 def scalar_sampler(phantom):
     """A fast scalar lookup ``f(x, y) -> (surface_z, dz_dx, dz_dy, kappa, lam)``.
 

@@ -24,6 +24,7 @@ from vic_drake.analysis.phantom_motion import (
     replay_table,
 )
 from vic_drake.analysis.real_comparison import compare_contact_loss, compare_with_real
+from vic_drake.control.references import has_tank
 from vic_drake.errors import VicDrakeError
 from vic_drake.experiments.lateral_replay import (
     AUTO,
@@ -318,7 +319,7 @@ def compare_real(
         "z_rmse_mm": metrics["z_rmse_mm"],
         "kz_corr": metrics["kz_corr"],
         "tank_min_J": metrics["tank_min_J"]
-        if scenario.controller.reference.controller in ("vs-cf", "vs-vf")
+        if has_tank(scenario.controller.reference)
         else None,
         "rtf": result.rtf,
     }

@@ -54,20 +54,61 @@ def loads_scenario(text: str) -> Scenario:
 
 def _load(source: dict, where: str) -> Scenario:
     """yaml_load_typed on one source (``filename=`` or ``data=``), then validate."""
-    try:
-        scenario = yaml_load_typed(schema=Scenario, **source)
-    except VicDrakeError as exc:
-        raise VicDrakeError(f"{where}: {exc}") from None
-    except Exception as exc:
-        # Drake's loader raises RuntimeError, ValueError or yaml errors.
-        raise VicDrakeError(f"{where}: {_explain(source, exc)}") from None
+    scenario = load_typed(
+        Scenario,
+        source,
+        where,
+        schema_name="vic_drake.scenario.Scenario",
+        other_files=OTHER_FILES,
+    )
     try:
         return scenario.validate()
     except (VicDrakeError, TypeError, ValueError) as exc:
         raise VicDrakeError(f"{where}: {exc}") from None
 
 
-def _explain(source: dict, exc: Exception) -> str:
+def load_typed(
+    schema: type,
+    source: dict,
+    where: str,
+    *,
+    schema_name: str,
+    other_files: dict | None = None,
+):
+    """``yaml_load_typed`` of a config dataclass, its errors naming the field.
+
+    Drake's loader reports some errors without the field (a wrong scalar:
+    "invalid literal for int()") and unknown fields without the allowed
+    ones; this names the field path, the bad value and, for an unknown
+    field, the allowed names. Used for scenarios and campaign specs.
+
+    Args:
+        schema: the dataclass to load (its fields are filled from the file).
+        source: ``{"filename": path}`` or ``{"data": text}``.
+        where: what the messages start with, e.g. "scenario file 'x.yaml'".
+        schema_name: the type named in the message, e.g.
+            "vic_drake.scenario.Scenario".
+        other_files: {top-level key: what a file with that key is} for the
+            YAMLs of another kind that a user may give instead (e.g.
+            :data:`OTHER_FILES` for scenarios).
+
+    Raises:
+        VicDrakeError: "{where}: {field and problem} (the fields and types
+            are those of {schema_name})", or "{where}: not a ...: its
+            top-level key ... marks ...".
+    """
+    try:
+        return yaml_load_typed(schema=schema, **source)
+    except VicDrakeError as exc:
+        raise VicDrakeError(f"{where}: {exc}") from None
+    except Exception as exc:
+        # Drake's loader raises RuntimeError, ValueError or yaml errors.
+        raise VicDrakeError(
+            f"{where}: {_explain(source, exc, schema, schema_name, other_files)}"
+        ) from None
+
+
+def _explain(source: dict, exc: Exception, schema, schema_name, other_files) -> str:
     """What is wrong: another kind of file, or the field path of the error
     (the Drake loader reports it without one)."""
     try:
@@ -75,12 +116,12 @@ def _explain(source: dict, exc: Exception) -> str:
     except Exception:
         return str(exc)
     if isinstance(raw, dict):
-        for key, kind in OTHER_FILES.items():
+        for key, kind in (other_files or {}).items():
             if key in raw:
                 return f"not a scan scenario: its top-level key {key!r} marks {kind}"
-    path = _first_bad_field(raw, Scenario, "")
+    path = _first_bad_field(raw, schema, "")
     what = f"field {path}" if path else f"{type(exc).__name__}: {exc}"
-    return f"{what} (the fields and types are those of vic_drake.scenario.Scenario)"
+    return f"{what} (the fields and types are those of {schema_name})"
 
 
 def _record_types(tp) -> dict | None:
@@ -132,7 +173,8 @@ def _first_bad_field(value, tp, path: str) -> str | None:
             tp is not bool and isinstance(value, bool)
         )
         if not ok:
-            return f"{path} must be a {tp.__name__}; got {value!r}"
+            article = "an" if tp is int else "a"
+            return f"{path} must be {article} {tp.__name__}; got {value!r}"
     return None
 
 

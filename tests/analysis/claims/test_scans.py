@@ -188,3 +188,33 @@ def test_scan_limits_are_the_controllers_settings():
     assert limits == C.ScanLimits.from_controller(p)
     assert limits.k_min_z_N_per_m == p.qp.stiffness_min_N_per_m[2]
     assert limits.power_max_W == -p.tank.power_limit_W
+
+
+def test_controllers_without_a_tank_have_nan_tank_metrics():
+    """CS and CF have no tank: their log holds its initial energy (0.5 J,
+    0 W), which is no tank minimum. VS keeps its figures; C7 reads only
+    VS-VF's and passes as before."""
+    from vic_drake.control.params import real_controller_params
+
+    t = np.arange(0, 10, 0.01)
+    flat = _scan(7 + 0 * t, t=t, ref=7.0, tank_energy_J=0.5, tank_power_W=0.0)
+    for name in ("cs", "cf"):
+        limits = C.ScanLimits.from_controller(real_controller_params(name))
+        assert not limits.has_tank
+        m = C.scan_metrics(flat, limits=limits)
+        assert np.isnan(m["tank_min_J"]) and np.isnan(m["tank_power_min_W"])
+    for name in ("vs-cf", "vs-vf"):
+        limits = C.ScanLimits.from_controller(real_controller_params(name))
+        assert limits.has_tank
+        m = C.scan_metrics(flat, limits=limits)
+        assert m["tank_min_J"] == 0.5 and m["tank_power_min_W"] == 0.0
+    no_tank = C.ScanLimits.from_controller(real_controller_params("cs"))
+    others = {
+        k: C.scan_metrics(
+            _scan(np.full(t.size, peak), t=t, tank_energy_J=0.5, tank_power_W=0.0),
+            limits=no_tank,
+        )
+        for k, peak in (("cs", 20.0), ("cf", 14.0))
+    }
+    claim = C.claim_c7({"vs-vf": _disturbed(), **others}, None)
+    assert claim.passed and claim.sim["tank_min_J"] == pytest.approx(0.45)

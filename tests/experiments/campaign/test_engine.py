@@ -1,6 +1,7 @@
 """Campaigns end to end on Dask: smoke, an external cluster, interrupt + resume."""
 
 import json
+import math
 import os
 import signal
 import subprocess
@@ -62,6 +63,12 @@ def test_smoke_campaign_passes_with_no_failed_or_nan_run(smoke_local):
     assert rows["peak_force_N"].between(1.0, 40.0).all()  # Every probe pressed.
     vs = rows[rows["factor.controller"].str.startswith("vs")]
     assert (vs["tank_min_J"] >= vs["tank_floor_J"] - 1e-9).all()
+    # CS and CF have no tank: no floor, no minimum (their log holds 0.5 J).
+    tankless = rows[rows["factor.controller"].isin(["cs", "cf"])]
+    assert tankless[["tank_min_J", "tank_floor_J"]].isna().all().all()
+    tank = {k: v["tank_min_J"] for k, v in summary["per_controller"].items()}
+    assert math.isnan(tank["cs"]) and math.isnan(tank["cf"])
+    assert 0.4 <= tank["vs-cf"] < 0.5 and 0.4 <= tank["vs-vf"] < 0.5
     table = pd.read_parquet(smoke_local / "results.parquet")
     assert len(table) == 16
     # Each run's scenario replays: it is the run's own, loadable by scan.
@@ -80,6 +87,8 @@ def test_json_output_has_exactly_the_contract_keys(smoke_local, capsys):
     result, _ = _run_cli([SMOKE, "--out", smoke_local, "--resume"], capsys)
     assert list(result) == list(JSON_KEYS)
     assert result["finished"] == 16 and result["runs_per_hour"] == 0.0
+    assert result["session_runs"] == 0
+    assert result["per_controller"]["cs"]["tank_min_J"] is None  # NaN: no tank.
     for entry in result["per_controller"].values():
         assert list(entry) == list(CONTROLLER_KEYS)
         assert len(entry["exceed_prob_ci95"]) == 2
@@ -208,3 +217,48 @@ def test_interrupted_campaign_resumes_to_exactly_the_planned_runs(tmp_path, caps
     for name, text in before.items():  # Finished runs were not run again.
         assert (rows_dir / name).read_text() == text
     assert f"] {8 - len(before)} runs on 1 Dask workers" in err
+    assert result["session_runs"] == 8 - len(before)  # The rate's runs.
+
+
+@pytest.mark.slow
+def test_ctrl_c_stops_quietly_and_says_how_to_finish(tmp_path):
+    """Ctrl-C as a terminal sends it: to the whole process group (the
+    campaign, its Dask workers, their runs' processes), and twice, as
+    ``timeout -s INT`` does."""
+    spec = tmp_path / "spec.yaml"
+    spec.write_text(
+        f"name: stop\nbase_scenario: {CAMPAIGNS / 'base' / 'short_scan_synthetic.yaml'}\n"
+        "runs: 8\nseed: 5\nduration_s: 0.6\n"
+        "factors:\n  - {field: controller, dist: grid, labels: [cs, vs-vf]}\n"
+    )
+    out = tmp_path / "out"
+    cmd = [sys.executable, "-m", "vic_drake.cli", "campaign", str(spec)]
+    proc = subprocess.Popen(
+        [*cmd, "--out", str(out), "--workers", "2"],
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
+    rows_dir = out / "rows"
+    deadline = time.time() + 600
+    while time.time() < deadline and proc.poll() is None:
+        if rows_dir.exists() and len(list(rows_dir.glob("run_*.json"))) >= 1:
+            break
+        time.sleep(0.2)
+    os.killpg(proc.pid, signal.SIGINT)
+    os.killpg(proc.pid, signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, err
+    kept = len(list(rows_dir.glob("run_*.json")))
+    assert "Traceback" not in err and "WARNING" not in err, err
+    assert f"interrupted: {kept} of 8 runs done, kept in {str(out)!r}" in err
+    assert f"finish the campaign with: vic-drake campaign {spec} --out {out}" in err
+    assert err.rstrip().endswith("--resume\nvic-drake: interrupted"), err
+    for _ in range(100):  # No worker nor run process is left behind.
+        try:
+            os.killpg(proc.pid, 0)
+        except ProcessLookupError:
+            break
+        time.sleep(0.1)
+    else:
+        pytest.fail("processes of the campaign's group are still running")

@@ -135,6 +135,38 @@ def test_bad_specs_fail_before_any_run(tmp_path, body, message):
         _plans(_spec(tmp_path, body))
 
 
+@pytest.mark.parametrize(
+    "body, message",
+    [
+        # As for a scenario YAML: the field named, the allowed ones listed.
+        ("seed_: 1\n", r"field seed_ is unknown; allowed: \[.*'seed'"),
+        ("duraton_s: 2.5\n", r"field duraton_s is unknown; allowed: \[.*'duration_s'"),
+        ("force_limit_N: high\n", "field force_limit_N must be a float; got 'high'"),
+        (
+            "factors:\n  - {field: controller, dist: grid, lables: [cs]}\n",
+            r"field factors\[0\]\.lables is unknown; allowed: \[.*'labels'",
+        ),
+        (
+            "factors:\n  - {field: seed, dist: uniform, low: a, high: 1}\n",
+            r"field factors\[0\]\.low must be a float; got 'a'",
+        ),
+    ],
+)
+def test_spec_errors_name_the_field_like_scenario_errors(tmp_path, body, message):
+    with pytest.raises(VicDrakeError, match=message) as err:
+        load_campaign_spec(_spec(tmp_path, body))
+    assert str(err.value).startswith(f"campaign spec {str(tmp_path / 'spec.yaml')!r}:")
+    assert "CampaignSpec" in str(err.value)
+
+
+def test_a_wrong_scalar_is_named_with_its_field(tmp_path):
+    # _spec writes seed: 3; a spec of its own with a word for the seed.
+    path = tmp_path / "spec.yaml"
+    path.write_text(f"name: t\nbase_scenario: {BASE}\nseed: one\n")
+    with pytest.raises(VicDrakeError, match="field seed must be an int; got 'one'"):
+        load_campaign_spec(path)
+
+
 def test_missing_files_are_named(tmp_path):
     with pytest.raises(VicDrakeError, match="does not exist"):
         load_campaign_spec(tmp_path / "none.yaml")

@@ -22,7 +22,9 @@ from vic_drake.analysis.contact import (
     pressing_force_N,
     scan_window,
 )
+from vic_drake.analysis.scan_metrics import tank_min_J
 from vic_drake.control.params import ControllerParams
+from vic_drake.control.references import has_tank as controller_has_tank
 from vic_drake.errors import VicDrakeError
 
 
@@ -42,12 +44,15 @@ class ScanLimits:
         tank_min_J: T_min.
         power_max_W: the power valve's limit P_max (> 0).
         eps_d_m: VS-VF's desired penetration.
+        has_tank: the controller has an energy tank (VS-CF, VS-VF); without
+            one (CS, CF) the tank metrics are NaN.
     """
 
     k_min_z_N_per_m: float = _default(lambda p: p.qp.stiffness_min_N_per_m[2])
     tank_min_J: float = _default(lambda p: p.tank.min_energy_J)
     power_max_W: float = _default(lambda p: -p.tank.power_limit_W)
     eps_d_m: float = _default(lambda p: p.reference.eps_d_m)
+    has_tank: bool = True
 
     @classmethod
     def from_controller(cls, params: ControllerParams) -> "ScanLimits":
@@ -57,6 +62,7 @@ class ScanLimits:
             tank_min_J=float(params.tank.min_energy_J),
             power_max_W=float(-params.tank.power_limit_W),
             eps_d_m=float(params.reference.eps_d_m),
+            has_tank=controller_has_tank(params.reference),
         )
 
 
@@ -86,7 +92,8 @@ def scan_metrics(
         peak_force_N (whole run), lifted_off (mean pressing force of the
         last end_s below the contact threshold), and where the columns
         exist: penetration / force-cap metrics (C6), contact-loss, stiffness
-        and tank metrics (C7).
+        and tank metrics (C7; the tank's NaN for a controller without one,
+        ``limits.has_tank`` False).
     """
     limits = ScanLimits() if limits is None else limits
     missing = [c for c in REQUIRED_SCAN_COLUMNS if c not in df.columns]
@@ -120,9 +127,11 @@ def scan_metrics(
     if w.any():
         out.update(_contact_loss_metrics(df, w, limits))
     if "tank_energy_J" in df.columns:
-        out["tank_min_J"] = float(df["tank_energy_J"].min())
+        out["tank_min_J"] = tank_min_J(df, has_tank=limits.has_tank)
     if "tank_power_W" in df.columns:
-        out["tank_power_min_W"] = float(df["tank_power_W"].min())
+        out["tank_power_min_W"] = (
+            float(df["tank_power_W"].min()) if limits.has_tank else float("nan")
+        )
     if "stiffness_z_N_per_m" in df.columns:
         out["stiffness_z_max_N_per_m"] = float(df["stiffness_z_N_per_m"].max())
     return out

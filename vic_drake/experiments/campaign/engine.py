@@ -14,17 +14,33 @@ The output folder::
     results.parquet       every row (written at the end)
     summary.json, summary.html
 
+``--out`` may be new or empty, or with ``resume`` this campaign's folder
+(a resume into a new or empty one says so and starts); a folder holding
+anything else, such as a reproduce run, is refused before any work. The
+folder is made once the cluster is reached, so a campaign that cannot
+start leaves nothing behind.
+
 A worker that dies loses its current run; the scheduler gives that run to
 another worker once (``distributed.scheduler.allowed-failures`` = 1 on a
 local cluster; an external scheduler uses its own setting), then the run is
 recorded as failed. ``resume`` skips every run with a row and never runs
 one twice.
+
+Ctrl-C stops the campaign: the local workers ignore it (the runs' own
+processes stop on it), the campaign closes the cluster with Dask's
+warnings hidden, says how many runs are kept and the command that finishes
+the rest, and raises KeyboardInterrupt.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
+import logging
 import os
+import shlex
+import signal
+import threading
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -37,6 +53,7 @@ from vic_drake.experiments.campaign.run import failed_row
 from vic_drake.experiments.campaign.spec import CampaignSpec, load_campaign_spec
 from vic_drake.experiments.campaign.stats import per_controller
 from vic_drake.malloc_tuning import tuned_environment
+from vic_drake.paths import check_output_dir
 from vic_drake.scenario import dumps_scenario, load_scenario
 
 
@@ -62,10 +79,24 @@ def read_rows(out: Path) -> pd.DataFrame:
     return df.sort_values("index").reset_index(drop=True) if not df.empty else df
 
 
-def _prepare(out: Path, spec_text: str, plans: list[RunPlan], resume: bool) -> set[str]:
-    """Creates or checks the folder; returns the run ids already finished."""
+#: The marker of a vic-drake reproduce run's folder (vic_drake.reproduce.run_dir).
+REPRODUCE_MARKER = "run.json"
+
+
+def _check_out(
+    out: Path, spec_text: str, plans: list[RunPlan], resume: bool, emit
+) -> set[str]:
+    """Checks ``out`` before any work, writing nothing; returns the run ids
+    already finished there.
+
+    ``out`` may be new, an empty folder, or (with ``resume``) this
+    campaign's folder; a folder holding anything else is refused, so a
+    campaign never mixes its files into another run's folder.
+    """
+    if out.exists() and not out.is_dir():
+        raise VicDrakeError(f"--out {str(out)!r} is a file; give a folder")
     stored = out / "spec.yaml"
-    if stored.exists():
+    if stored.is_file():
         if not resume:
             raise VicDrakeError(
                 f"{str(out)!r} already holds a campaign; pass --resume to finish it "
@@ -75,11 +106,42 @@ def _prepare(out: Path, spec_text: str, plans: list[RunPlan], resume: bool) -> s
             raise VicDrakeError(
                 f"{str(out)!r} holds another campaign spec; --resume needs the same spec"
             )
+        if not os.access(out, os.W_OK | os.X_OK):
+            raise VicDrakeError(f"--out {str(out)!r} cannot be written")
+        planned = {p.run_id for p in plans}
+        return {p.stem for p in (out / "rows").glob("run_*.json")} & planned
+    if out.is_dir() and any(out.iterdir()):
+        raise VicDrakeError(
+            f"--out {str(out)!r} holds {_contents(out)}, not a campaign; give a new "
+            "or empty folder (or, with --resume, a campaign's own folder)"
+        )
+    if out.is_dir():
+        if not os.access(out, os.W_OK | os.X_OK):
+            raise VicDrakeError(f"--out {str(out)!r} cannot be written")
+    else:
+        check_output_dir(out.parent, option="--out's parent folder")
+    if resume:
+        # Starting is what --resume asks for in the end (every run done),
+        # and nothing can be lost in a new or empty folder.
+        where = "is empty" if out.is_dir() else "does not exist"
+        emit(f"nothing to resume: {str(out)!r} {where}; starting the campaign")
+    return set()
+
+
+def _contents(out: Path) -> str:
+    """What a folder that is not a campaign holds, for the refusal."""
+    if (out / REPRODUCE_MARKER).is_file():
+        return f"a vic-drake reproduce run ({REPRODUCE_MARKER})"
+    names = sorted(p.name + ("/" if p.is_dir() else "") for p in out.iterdir())
+    shown = ", ".join(names[:4]) + (", ..." if len(names) > 4 else "")
+    return f"other files ({shown}; no spec.yaml)"
+
+
+def _create(out: Path, spec_text: str) -> None:
+    """Makes the campaign's folder and writes its spec (once the runs can start)."""
     (out / "scenarios").mkdir(parents=True, exist_ok=True)
     (out / "rows").mkdir(exist_ok=True)
-    _atomic_write(stored, spec_text)
-    planned = {p.run_id for p in plans}
-    return {p.stem for p in (out / "rows").glob("run_*.json")} & planned
+    _atomic_write(out / "spec.yaml", spec_text)
 
 
 def _record(out: Path, plan: RunPlan, row: dict) -> None:
@@ -131,6 +193,8 @@ def _client(workers: int | None, scheduler: str | None):
         tuned_environment(os.environ)
     except ValueError as exc:
         raise VicDrakeError(str(exc)) from None
+    from vic_drake.experiments.campaign.workers import IgnoreCtrlC
+
     with dask.config.set({"distributed.scheduler.allowed-failures": 1}):
         cluster = LocalCluster(
             n_workers=n,
@@ -139,7 +203,61 @@ def _client(workers: int | None, scheduler: str | None):
             dashboard_address=":0",  # A free port: never clash with another cluster.
             env={"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"},
         )
-    return Client(cluster), cluster
+    client = Client(cluster)
+    client.register_plugin(IgnoreCtrlC())  # Ctrl-C stops the cluster in order.
+    return client, cluster
+
+
+@contextlib.contextmanager
+def _ctrl_c_stops_once():
+    """The first Ctrl-C raises KeyboardInterrupt; later ones are ignored.
+
+    They would break the cluster's stop after the first, leaving its threads
+    and processes behind: ``timeout -s INT`` sends two SIGINTs at once, an
+    impatient user may press twice. Only in the main thread (the only one
+    Python delivers signals to).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    state = {"raised": False}
+
+    def handler(_signum, _frame):
+        if not state["raised"]:
+            state["raised"] = True
+            raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGINT, handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+@contextlib.contextmanager
+def _quiet_logs(quiet: bool):
+    """While the cluster stops after Ctrl-C, Dask's and tornado's warnings
+    about the cancelled runs and the lost workers are no news: hidden."""
+    loggers = [logging.getLogger(n) for n in ("distributed", "tornado")]
+    levels = [lg.level for lg in loggers]
+    if quiet:
+        for lg in loggers:
+            lg.setLevel(logging.CRITICAL)
+    try:
+        yield
+    finally:
+        for lg, level in zip(loggers, levels, strict=True):
+            lg.setLevel(level)
+
+
+def _resume_command(spec_path, out: Path, workers, scheduler) -> str:
+    """The command that finishes this campaign, for the interrupted message."""
+    cmd = ["vic-drake", "campaign", str(spec_path), "--out", str(out)]
+    if scheduler:
+        cmd += ["--scheduler", scheduler]
+    elif workers:
+        cmd += ["--workers", str(workers)]
+    return shlex.join([*cmd, "--resume"])
 
 
 def run_campaign(
@@ -165,8 +283,10 @@ def run_campaign(
             interrupted campaign in tests and benchmarks; None: all).
 
     Returns:
-        The summary of :func:`summary_dict` plus ``wall_s``,
-        ``runs_per_hour`` (runs finished by this call) and ``workers``.
+        The summary of :func:`summary_dict` plus ``session_runs`` (the
+        runs finished by this call; a resume's earlier ones are not
+        counted), ``wall_s`` and ``runs_per_hour`` (this call's) and
+        ``workers``.
     """
     if workers is not None and scheduler:
         raise VicDrakeError("give either --workers or --scheduler, not both")
@@ -175,21 +295,28 @@ def run_campaign(
     spec, base_path = load_campaign_spec(spec_path)
     plans = plan_campaign(spec, load_scenario(base_path))
     out = Path(out)
-    done = _prepare(out, _spec_text(spec, base_path), plans, resume)
+    emit = progress or (lambda _line: None)
+    spec_text = _spec_text(spec, base_path)
+    done = _check_out(out, spec_text, plans, resume, emit)
     todo = [p for p in plans if p.run_id not in done]
     if max_runs is not None:
         todo = todo[:max_runs]
-    emit = progress or (lambda _line: None)
     bar = _Progress(spec.name, len(plans), len(done), emit)
     t0 = time.perf_counter()
     n_workers = 0
     if todo:
-        n_workers = _submit(todo, out, workers, scheduler, bar, emit)
+        # The folder is made once the cluster is reached (_submit): a
+        # campaign that cannot start leaves nothing behind.
+        hint = _resume_command(spec_path, out, workers, scheduler)
+        n_workers = _submit(todo, out, spec_text, workers, scheduler, bar, emit, hint)
+    else:
+        _create(out, spec_text)
     wall = time.perf_counter() - t0
     rows = read_rows(out)
     summary = summary_dict(spec, rows)
     new = bar.done - bar.done0
     summary.update(
+        session_runs=new,
         wall_s=wall,
         runs_per_hour=new / wall * 3600 if wall > 0 and new else 0.0,
         workers=n_workers,
@@ -200,41 +327,57 @@ def run_campaign(
     return summary
 
 
-def _submit(todo, out: Path, workers, scheduler, bar: _Progress, emit) -> int:
+def _submit(
+    todo, out: Path, spec_text: str, workers, scheduler, bar: _Progress, emit, hint
+) -> int:
     from distributed import as_completed
 
     from vic_drake.experiments.campaign.run import execute_run_in_child
 
     client, cluster = _client(workers, scheduler)
     futures = {}
-    try:
-        n_workers = len(client.scheduler_info()["workers"])
-        emit(
-            f"[{bar.name}] {len(todo)} runs on {n_workers} Dask workers ({client.scheduler.address})"
-        )
-        for plan in todo:
-            fut = client.submit(
-                execute_run_in_child,
-                plan,
-                pure=False,
-                key=f"{bar.name}-{plan.run_id}-{time.time_ns()}",
+    interrupted = False
+    with _ctrl_c_stops_once():
+        try:
+            _create(out, spec_text)
+            n_workers = len(client.scheduler_info()["workers"])
+            emit(
+                f"[{bar.name}] {len(todo)} runs on {n_workers} Dask workers "
+                f"({client.scheduler.address})"
             )
-            futures[fut] = plan
-        for fut in as_completed(list(futures)):
-            plan = futures[fut]
-            try:
-                row = fut.result()
-            except Exception as exc:  # noqa: BLE001 - e.g. KilledWorker after the retry.
-                row = failed_row(plan, f"{type(exc).__name__}: {exc}")
-            _record(out, plan, row)
-            bar.add(row)
-        return n_workers
-    finally:
-        for fut in futures:
-            fut.cancel()
-        client.close()
-        if cluster is not None:
-            cluster.close()
+            for plan in todo:
+                fut = client.submit(
+                    execute_run_in_child,
+                    plan,
+                    pure=False,
+                    key=f"{bar.name}-{plan.run_id}-{time.time_ns()}",
+                )
+                futures[fut] = plan
+            for fut in as_completed(list(futures)):
+                plan = futures[fut]
+                try:
+                    row = fut.result()
+                except Exception as exc:  # noqa: BLE001 - e.g. KilledWorker after the retry.
+                    row = failed_row(plan, f"{type(exc).__name__}: {exc}")
+                _record(out, plan, row)
+                bar.add(row)
+            return n_workers
+        except KeyboardInterrupt:
+            interrupted = True
+            raise
+        finally:
+            with _quiet_logs(interrupted):
+                for fut in futures:
+                    fut.cancel()
+                client.close()
+                if cluster is not None:
+                    cluster.close()
+            if interrupted:
+                kept = len(list((out / "rows").glob("run_*.json")))
+                emit(
+                    f"[{bar.name}] interrupted: {kept} of {bar.total} runs done, kept "
+                    f"in {str(out)!r}; finish the campaign with: {hint}"
+                )
 
 
 def summary_dict(spec: CampaignSpec, rows: pd.DataFrame) -> dict:

@@ -31,7 +31,9 @@ def _atomic(path: Path, data: bytes) -> None:
 
 def _fmt(v) -> str:
     if isinstance(v, float):
-        return "NaN" if math.isnan(v) else f"{v:.4g}"
+        # No value (a failed run's metrics; CS's and CF's tank, which they
+        # do not have): a dash, as in the reproduce report.
+        return "—" if math.isnan(v) else f"{v:.4g}"
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(_fmt(x) for x in v) + "]"
     return html.escape(str(v))

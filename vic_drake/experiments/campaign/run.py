@@ -21,6 +21,7 @@ import pandas as pd
 
 from vic_drake.analysis.contact import contact_loss_intervals, scan_window
 from vic_drake.analysis.scan_metrics import tank_min_J
+from vic_drake.control.references import has_tank
 from vic_drake.experiments.campaign.plan import RunPlan
 from vic_drake.malloc_tuning import tuned_environment
 from vic_drake.scenario import dumps_scenario
@@ -40,13 +41,17 @@ METRIC_KEYS = (
 )
 
 
-def run_metrics(df: pd.DataFrame, *, force_limit_N: float) -> dict:
+def run_metrics(
+    df: pd.DataFrame, *, force_limit_N: float, has_tank: bool = True
+) -> dict:
     """The safety metrics of one run's log.
 
     The force is the tissue's force on the probe (``force_tissue_z_N``, the
     force on the patient, not what a faulty sensor reports). Contact losses
     are :func:`vic_drake.analysis.contact.contact_loss_intervals` inside the
     scan window. ``qp_failures`` counts logged samples with ``qp_ok`` = 0.
+    ``tank_min_J`` is NaN for a controller without a tank (``has_tank``
+    False: CS, CF).
     """
     t = df["t_s"].to_numpy(float)
     f = df["force_tissue_z_N"].to_numpy(float)
@@ -58,7 +63,7 @@ def run_metrics(df: pd.DataFrame, *, force_limit_N: float) -> dict:
         "p99_force_N": float(np.nanpercentile(f, 99)),
         "time_above_limit_s": float(dt[f > force_limit_N].sum()),
         "contact_loss_s": float(sum(b - a for a, b in losses)),
-        "tank_min_J": tank_min_J(df),
+        "tank_min_J": tank_min_J(df, has_tank=has_tank),
         "qp_failures": int(np.sum(qp_ok < 0.5)),
     }
 
@@ -89,12 +94,15 @@ def execute_run(plan: RunPlan) -> dict:
     try:
         scenario = plan.scenario()
         row["_scenario_yaml"] = dumps_scenario(scenario)
-        row["tank_floor_J"] = float(scenario.controller.tank.min_energy_J)
+        tank = has_tank(scenario.controller.reference)
+        # CS and CF have no tank: no floor, no minimum (NaN).
+        if tank:
+            row["tank_floor_J"] = float(scenario.controller.tank.min_energy_J)
         result = run_scan(scenario, duration_s=plan.duration_s)
         df = result.df
         bad = _nan_columns(df)
         with np.errstate(all="ignore"):
-            row.update(run_metrics(df, force_limit_N=plan.force_limit_N))
+            row.update(run_metrics(df, force_limit_N=plan.force_limit_N, has_tank=tank))
         if bad:
             row["status"] = "nan"
             first = float(

@@ -28,10 +28,8 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
-import yaml
-from pydrake.common.yaml import yaml_load_typed
-
 from vic_drake.errors import VicDrakeError
+from vic_drake.scenario.io import load_typed
 
 #: The distributions a factor may have.
 DISTRIBUTIONS = ("uniform", "normal", "choice", "grid")
@@ -156,11 +154,19 @@ def load_campaign_spec(path: str | os.PathLike) -> tuple[CampaignSpec, Path]:
     path = Path(path)
     if not path.is_file():
         raise VicDrakeError(f"campaign spec {str(path)!r} does not exist")
+    where = f"campaign spec {str(path)!r}"
+    # The scenario loader's treatment: the bad field named, the allowed ones
+    # listed for an unknown field.
+    spec = load_typed(
+        CampaignSpec,
+        {"filename": str(path)},
+        where,
+        schema_name="vic_drake.experiments.campaign.CampaignSpec",
+    )
     try:
-        spec = yaml_load_typed(schema=CampaignSpec, filename=str(path))
-    except (RuntimeError, ValueError, TypeError, yaml.YAMLError) as exc:
-        raise VicDrakeError(f"campaign spec {str(path)!r}: {exc}") from None
-    spec.validate()
+        spec.validate()
+    except VicDrakeError as exc:
+        raise VicDrakeError(f"{where}: {exc}") from None
     base = Path(spec.base_scenario)
     if not base.is_absolute():
         base = (path.parent / base).resolve()

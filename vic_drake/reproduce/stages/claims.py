@@ -89,7 +89,10 @@ def _metrics_table(ctx: RunContext, title: str, metrics: dict) -> None:
     rows = []
     for cond, by_ctrl in metrics.items():
         for ctrl, m in by_ctrl.items():
-            rows.append([cond, ctrl, *(m.get(k) for k in _TABLE_KEYS)])
+            # NaN (CS's and CF's tank: they have none) shows as a missing
+            # metric does: a dash.
+            values = (m.get(k) for k in _TABLE_KEYS)
+            rows.append([cond, ctrl, *(None if v != v else v for v in values)])
     if rows:
         ctx.tables.append(
             ReportTable(

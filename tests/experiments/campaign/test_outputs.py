@@ -1,0 +1,175 @@
+"""A campaign's folder rules and displayed figures, without running a scan.
+
+The folder is checked before any work and made only once the cluster is
+reached (a fake cluster that fails stands in for Dask); CS and CF have no
+tank, so their tank figures are NaN and show as a dash.
+"""
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from vic_drake.commands.campaign import _human
+from vic_drake.errors import VicDrakeError
+from vic_drake.experiments.campaign import engine, run_campaign, run_metrics
+from vic_drake.experiments.campaign.report import summary_html
+from vic_drake.experiments.campaign.spec import CampaignSpec
+from vic_drake.experiments.campaign.stats import per_controller
+
+SMOKE = Path(__file__).resolve().parents[3] / "campaigns" / "smoke.yaml"
+
+
+class _NoCluster(Exception):
+    """Raised by the fake cluster: the campaign got as far as connecting."""
+
+
+@pytest.fixture
+def no_cluster(monkeypatch):
+    """The cluster cannot be reached, as with an unreachable --scheduler."""
+
+    def fail(workers, scheduler):
+        raise _NoCluster
+
+    monkeypatch.setattr(engine, "_client", fail)
+
+
+def _listing(folder: Path) -> list[str]:
+    return sorted(str(p.relative_to(folder)) for p in folder.rglob("*"))
+
+
+def _reproduce_run(folder: Path) -> Path:
+    (folder / "logs").mkdir(parents=True)
+    (folder / "run.json").write_text('{"complete": true}\n')
+    (folder / "report.html").write_text("<html></html>")
+    return folder
+
+
+@pytest.mark.parametrize("resume", [True, False])
+def test_a_reproduce_run_folder_is_refused_and_left_alone(tmp_path, no_cluster, resume):
+    out = _reproduce_run(tmp_path / "quick")
+    before = _listing(out)
+    with pytest.raises(
+        VicDrakeError,
+        match=r"holds a vic-drake reproduce run \(run.json\), not a campaign",
+    ):
+        run_campaign(SMOKE, out, workers=1, resume=resume)
+    assert _listing(out) == before
+
+
+def test_a_folder_of_other_files_is_refused_naming_them(tmp_path, no_cluster):
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    (out / "data").mkdir()
+    with pytest.raises(VicDrakeError, match=r"holds other files \(data/, notes.txt;"):
+        run_campaign(SMOKE, out, workers=1, resume=True)
+    assert _listing(out) == ["data", "notes.txt"]
+
+
+def test_resume_without_a_campaign_says_so_and_starts(tmp_path, no_cluster):
+    lines = []
+    out = tmp_path / "new"
+    with pytest.raises(_NoCluster):  # It went on to start the campaign.
+        run_campaign(SMOKE, out, workers=1, resume=True, progress=lines.append)
+    assert lines == [
+        f"nothing to resume: {str(out)!r} does not exist; starting the campaign"
+    ]
+    out.mkdir()
+    lines.clear()
+    with pytest.raises(_NoCluster):
+        run_campaign(SMOKE, out, workers=1, resume=True, progress=lines.append)
+    assert lines == [f"nothing to resume: {str(out)!r} is empty; starting the campaign"]
+
+
+def test_a_campaign_that_cannot_start_leaves_no_folder(tmp_path, monkeypatch):
+    def unreachable(workers, scheduler):
+        raise VicDrakeError(f"cannot reach the Dask scheduler {scheduler!r}")
+
+    monkeypatch.setattr(engine, "_client", unreachable)
+    out = tmp_path / "c2"
+    for _ in range(2):  # The retry is not refused as "already holds a campaign".
+        with pytest.raises(VicDrakeError, match="cannot reach the Dask scheduler"):
+            run_campaign(SMOKE, out, scheduler="localhost:1")
+        assert not out.exists()
+
+
+def test_tankless_controllers_have_nan_tank_metrics():
+    t = np.arange(0, 3, 0.002)
+    df = pd.DataFrame(
+        {
+            "t_s": t,
+            "z_d_m": 0.085,
+            "force_sensor_z_N": -7.0,
+            "force_tissue_z_N": -7.0,
+            "tank_energy_J": 0.5,  # What CS and CF log: the initial energy.
+            "qp_ok": 1.0,
+        }
+    )
+    assert math.isnan(run_metrics(df, force_limit_N=15.0, has_tank=False)["tank_min_J"])
+    assert run_metrics(df, force_limit_N=15.0)["tank_min_J"] == 0.5
+
+
+def _rows() -> pd.DataFrame:
+    return pd.DataFrame(
+        {
+            "run_id": ["run_00000", "run_00001", "run_00002"],
+            "index": [0, 1, 2],
+            "status": ["ok"] * 3,
+            "error": [""] * 3,
+            "factor.controller": ["cs", "cf", "vs-vf"],
+            "peak_force_N": [7.4, 8.3, 7.1],
+            "contact_loss_s": [0.0, 0.0, 0.0],
+            "tank_min_J": [math.nan, math.nan, 0.444],
+        }
+    )
+
+
+def _result(session_runs: int, finished: int = 16) -> dict:
+    return {
+        "runs": 16,
+        "finished": finished,
+        "failed": 0,
+        "nan_runs": 0,
+        "session_runs": session_runs,
+        "wall_s": 15.0,
+        "runs_per_hour": session_runs / 15.0 * 3600,
+        "workers": 2,
+        "per_controller": per_controller(_rows(), 15.0),
+    }
+
+
+def test_the_console_table_shows_a_dash_for_no_tank():
+    text = _human(_result(16))
+    cs, vs = (
+        next(line.split() for line in text.splitlines() if line.startswith(name))
+        for name in ("cs ", "vs-vf ")
+    )
+    assert cs[-1] == "-" and vs[-1] == "0.444"
+    assert "nan" not in "\n".join(text.splitlines()[1:])  # The table, not "0 NaN".
+
+
+def test_the_summary_page_shows_a_dash_for_no_tank(tmp_path):
+    rows = _rows()
+    summary = {**_result(3, finished=3), "runs": 3}
+    page = summary_html(tmp_path, CampaignSpec(runs=3), rows, summary)
+    assert "<td>—</td>" in page and "<td>0.444</td>" in page
+    assert "<td>NaN</td>" not in page and "nan</td>" not in page
+
+
+def test_after_a_resume_the_rate_is_this_sessions_and_says_so():
+    # 8 runs in 15 s after 8 done before: 1920 runs/h, and the line says
+    # that these are 8 runs, not the 16 finished.
+    line = _human(_result(8)).splitlines()[0]
+    assert line == (
+        "16/16 runs finished, 0 failed (0 NaN); this session 8 runs in 15 s on "
+        "2 workers, 1920 runs/h (8 finished before)"
+    )
+    assert (
+        _human(_result(16))
+        .splitlines()[0]
+        .endswith("16 runs in 15 s on 2 workers, 3840 runs/h")
+    )
+    assert _human(_result(0)).splitlines()[0].endswith("nothing left to run")
