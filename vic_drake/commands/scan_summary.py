@@ -118,6 +118,7 @@ def scan_metrics_dict(scenario, result, path: Path, force_limit_N=None) -> dict:
     import numpy as np
 
     from vic_drake.analysis import contact, scan_metrics
+    from vic_drake.control.references import has_tank
     from vic_drake.experiments.campaign import run_metrics
 
     df = result.df
@@ -128,9 +129,12 @@ def scan_metrics_dict(scenario, result, path: Path, force_limit_N=None) -> dict:
         force_limit_N, limit_source = campaign_force_limit(path)
     else:
         limit_source = "--force-limit"
+    tank = has_tank(scenario.controller.reference)
     with np.errstate(all="ignore"):
-        campaign = run_metrics(df, force_limit_N=force_limit_N)
-    campaign["tank_floor_J"] = float(scenario.controller.tank.min_energy_J)
+        campaign = run_metrics(df, force_limit_N=force_limit_N, has_tank=tank)
+    campaign["tank_floor_J"] = (
+        float(scenario.controller.tank.min_energy_J) if tank else float("nan")
+    )
     campaign["force_limit_N"] = float(force_limit_N)
     campaign["force_limit_source"] = limit_source
     return {
@@ -142,7 +146,7 @@ def scan_metrics_dict(scenario, result, path: Path, force_limit_N=None) -> dict:
         "force_rmse_N": None if controller == "cs" else scan_metrics.force_rmse_N(df),
         "force_range_N": list(scan_metrics.force_range_N(df)),
         "force_peak_N": scan_metrics.peak_force_N(df),
-        "tank_min_J": scan_metrics.tank_min_J(df),
+        "tank_min_J": scan_metrics.tank_min_J(df, has_tank=tank),
         "contact_loss_s": [list(i) for i in contact.contact_loss_intervals(df)],
         "lifted_off": scan_metrics.lifted_off(df),
         "scan_window_s": [float(t[window][0]), float(t[window][-1])]
