@@ -84,7 +84,7 @@ def test_a_running_run_is_not_clobbered(tmp_path):
     assert prepare_run_dir(out).is_dir()  # The writer is gone: cleared.
 
 
-def _complete_run(out, *, data_dir=None, stages=STAGE_NAMES, legacy=False):
+def _complete_run(out, *, data_dir=None, stages=STAGE_NAMES, legacy=False, quick=True):
     """A finished run in ``out``: report, figures and a marker like reproduce's."""
     work = prepare_run_dir(out)
     (work / "report.html").write_text("the whole run")
@@ -93,7 +93,23 @@ def _complete_run(out, *, data_dir=None, stages=STAGE_NAMES, legacy=False):
     fields = {"stages": [{"name": n, "ok": True, "status": "ok"} for n in stages]}
     if not legacy:  # Markers before this change did not record the data.
         fields["data_dir"] = data_dir
-    finish_run_dir(work, out, quick=True, **fields)
+    finish_run_dir(work, out, quick=quick, **fields)
+
+
+def test_a_quick_run_does_not_replace_a_full_one(tmp_path):
+    """A quick run over a full run would lose the full scans and compare_real."""
+    full = tmp_path / "full"
+    _complete_run(full, stages=("offline_sim", "claims"), quick=False)
+    with pytest.raises(VicDrakeError, match="it is a full run and this one is quick"):
+        prepare_run_dir(full, quick=True)
+    assert (full / "report.html").read_text() == "the whole run"
+    # A full run replaces it, and so does a quick one with overwrite.
+    assert prepare_run_dir(full, quick=True, overwrite=True).is_dir()
+    assert prepare_run_dir(full).is_dir()
+    # A quick run replaces a quick run.
+    quick = tmp_path / "quick"
+    _complete_run(quick, stages=("offline_sim", "claims"))
+    assert prepare_run_dir(quick, quick=True).is_dir()
 
 
 @pytest.fixture

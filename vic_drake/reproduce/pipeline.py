@@ -130,6 +130,7 @@ def reproduce(options: ReproduceOptions) -> ReproduceResult:
         stages=options.stages,
         data_dir=data_dir,
         overwrite=options.overwrite,
+        quick=options.quick,
     )
     ctx = RunContext(options, work_dir=work)
     t0 = time.perf_counter()

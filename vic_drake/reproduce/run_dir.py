@@ -80,7 +80,11 @@ def _stage_list(marker: dict) -> list[dict]:
 
 
 def check_replace(
-    out: Path, *, stages: tuple[str, ...] | None, data_dir: Path | None
+    out: Path,
+    *,
+    stages: tuple[str, ...] | None,
+    data_dir: Path | None,
+    quick: bool = False,
 ) -> None:
     """Refuses to replace the complete run in ``out`` with one that covers less.
 
@@ -88,6 +92,7 @@ def check_replace(
         out: ``--out`` (resolved).
         stages: the stages this run will run (None: all).
         data_dir: the paper's data this run uses (None: none).
+        quick: this run is a quick one (a full run is not replaced by it).
 
     Raises:
         VicDrakeError: ``out`` holds a complete run with a stage that ran
@@ -105,6 +110,11 @@ def check_replace(
         reasons.append(
             f"its stage(s) {', '.join(map(str, dropped))} would not run again "
             f"(--stages {','.join(stages or ())})"
+        )
+    if quick and marker.get("quick") is False:
+        reasons.append(
+            "it is a full run and this one is quick (shorter scans and "
+            "palpations, no compare_real)"
         )
     if _had_data(marker) and data_dir is None:
         reasons.append(
@@ -126,6 +136,7 @@ def prepare_run_dir(
     stages: tuple[str, ...] | None = None,
     data_dir: Path | None = None,
     overwrite: bool = False,
+    quick: bool = False,
 ) -> Path:
     """Checks ``--out`` and makes the run's work folder; returns the work folder.
 
@@ -139,6 +150,7 @@ def prepare_run_dir(
         stages: the stages this run will run (None: all).
         data_dir: the paper's data this run uses (None: none).
         overwrite: replace a previous run even when this one covers less.
+        quick: this run is a quick one.
 
     Raises:
         VicDrakeError: ``out_dir`` is a file, a folder of other files, a
@@ -159,7 +171,7 @@ def prepare_run_dir(
     if out.is_dir() and not os.access(out, os.W_OK | os.X_OK):
         raise VicDrakeError(f"--out {str(out)!r} cannot be written")
     if not overwrite:
-        check_replace(out, stages=stages, data_dir=data_dir)
+        check_replace(out, stages=stages, data_dir=data_dir, quick=quick)
     work = work_dir_for(out)
     if work.exists():
         if not (work.is_dir() and (_is_run_dir(work) or not any(work.iterdir()))):
