@@ -78,6 +78,25 @@ def _unknown_arguments(parser: argparse.ArgumentParser, args, extras) -> None:
     sub.error(f"{message} ({'; '.join(hints)})" if hints else message)
 
 
+def _check_command_name(parser: argparse.ArgumentParser, argv: list[str]) -> None:
+    """Fails on a misspelt command with the closest names (argparse alone
+    lists every command)."""
+    import difflib
+
+    words = [a for a in argv if not a.startswith("-")]
+    if not words:
+        return
+    names = list(parser.get_default("_subparsers").choices)
+    if words[0] in names:
+        return
+    near = difflib.get_close_matches(words[0], names, n=2, cutoff=0.6)
+    if near:
+        parser.error(
+            f"unknown command {words[0]!r} (did you mean {' or '.join(near)}?); "
+            f"the commands: {', '.join(names)}"
+        )
+
+
 #: Arguments that print and exit without running a command.
 _PRINT_ONLY = ("-h", "--help", "--version")
 
@@ -106,6 +125,7 @@ def main(argv: list[str] | None = None) -> int:
                 return 2
             print(f"vic-drake: note: {exc} (commands will not run)", file=sys.stderr)
     parser = build_parser()
+    _check_command_name(parser, sys.argv[1:] if argv is None else argv)
     args, extras = parser.parse_known_args(argv)
     if extras:
         _unknown_arguments(parser, args, extras)

@@ -153,3 +153,14 @@ def test_scan_help_describes_the_command_its_scenario_and_duration():
     assert "SCENARIO.yaml a scenario file: diagrams/*.yaml" in text
     assert "default: the scenario's duration_s, else its trajectory's end + 1 s" in text
     assert "peak_force_N is the tissue's force on the patient" in text
+
+
+def test_a_misspelt_command_names_the_closest(capsys):
+    from vic_drake.cli import main
+
+    with pytest.raises(SystemExit) as exit_info:
+        main(["reproduc", "--quick", "--out", "x"])
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err
+    assert "unknown command 'reproduc' (did you mean reproduce?)" in err
+    assert "compare-real" in err  # The commands are listed.
