@@ -144,3 +144,17 @@ def callgrind_in_checkout(
         if ticks is None or not dumps:
             sys.exit(f"the run of {tree} failed:\n{done.stderr[-2000:]}")
         return int(ticks.group(1)), dumps
+
+
+def data_dir_with_log(parser, data_dir, log: str):
+    """The data folder holding ``experiments/<log>``; exits with a message
+    when there is no data or no such log (for the benchmarks that need the
+    measured map and a shared log)."""
+    from vic_drake.paths import has_data, resolve_data_dir
+
+    if not has_data(data_dir):
+        sys.exit("this benchmark needs the data (the measured map); see README")
+    folder = resolve_data_dir(data_dir)
+    if not (folder / "experiments" / log).is_dir():
+        parser.error(f"--log: no log {log!r} in {folder / 'experiments'}")
+    return folder

@@ -16,15 +16,13 @@ measured map).
 from __future__ import annotations
 
 import argparse
-import sys
 import tempfile
 import time
 from pathlib import Path
 
-from common import versions
+from common import data_dir_with_log, versions
 
 from vic_drake.experiments.hand_roundtrip import MAX_EVENTS, hand_moved_roundtrip
-from vic_drake.paths import has_data, resolve_data_dir
 
 
 def main():
@@ -49,11 +47,7 @@ def main():
         parser.error(
             f"--events takes an integer from 1 to {MAX_EVENTS}; got {args.events}"
         )
-    if not has_data(args.data_dir):
-        sys.exit("this benchmark needs the data (the measured map); see README")
-    data_dir = resolve_data_dir(args.data_dir)
-    if not (data_dir / "experiments" / args.log).is_dir():
-        parser.error(f"--log: no log {args.log!r} in {data_dir / 'experiments'}")
+    data_dir = data_dir_with_log(parser, args.data_dir, args.log)
     print(versions())
     keep = Path(args.keep) if args.keep else None
     with tempfile.TemporaryDirectory() as tmp:

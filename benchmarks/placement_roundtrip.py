@@ -18,15 +18,13 @@ data (the measured map).
 from __future__ import annotations
 
 import argparse
-import sys
 import tempfile
 import time
 from pathlib import Path
 
-from common import versions
+from common import data_dir_with_log, versions
 
 from vic_drake.experiments.placement_roundtrip import placed_roundtrip
-from vic_drake.paths import has_data, resolve_data_dir
 
 
 def _floats(text: str, name: str, parser) -> list[float]:
@@ -53,11 +51,7 @@ def main():
     args = parser.parse_args()
     slopes = _floats(args.slopes, "--slopes", parser)
     modes = [m.strip() for m in args.modes.split(",") if m.strip()]
-    if not has_data(args.data_dir):
-        sys.exit("this benchmark needs the data (the measured map); see README")
-    data_dir = resolve_data_dir(args.data_dir)
-    if not (data_dir / "experiments" / args.log).is_dir():
-        parser.error(f"--log: no log {args.log!r} in {data_dir / 'experiments'}")
+    data_dir = data_dir_with_log(parser, args.data_dir, args.log)
     print(versions())
     with tempfile.TemporaryDirectory() as tmp:
         out_dir = Path(args.keep) if args.keep else Path(tmp)

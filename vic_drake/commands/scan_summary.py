@@ -36,10 +36,6 @@ SCAN_DESCRIPTION = (
 #: only holds still after its trajectory's end).
 MAX_EXTRA_DURATION_S = 60.0
 
-#: The campaigns' force limit when a scenario is not one of a campaign's runs
-#: (CampaignSpec.force_limit_N's default).
-DEFAULT_FORCE_LIMIT_N = 15.0
-
 
 def scenario_path(text: str, say=None) -> Path:
     """The scenario file ``text`` names.
@@ -94,8 +90,12 @@ def campaign_force_limit(path: Path) -> tuple[float, str]:
 
     A campaign run's scenario (``DIR/scenarios/run_*.yaml`` beside
     ``DIR/spec.yaml``) takes the campaign's ``force_limit_N``; any other
-    :data:`DEFAULT_FORCE_LIMIT_N`.
+    the campaigns' default (``CampaignSpec.force_limit_N``).
     """
+    # Here, not at the top: the campaign package costs ~0.9 s to import, and
+    # every vic-drake command builds this module's parser.
+    from vic_drake.experiments.campaign.spec import CampaignSpec
+
     spec = path.resolve().parent.parent / "spec.yaml"
     if path.resolve().parent.name == "scenarios" and spec.is_file():
         import yaml
@@ -106,7 +106,7 @@ def campaign_force_limit(path: Path) -> tuple[float, str]:
             value = math.nan
         if math.isfinite(value) and value > 0:
             return value, f"the campaign's {str(spec)!r}"
-    return DEFAULT_FORCE_LIMIT_N, "the campaigns' default"
+    return float(CampaignSpec.force_limit_N), "the campaigns' default"
 
 
 def scan_metrics_dict(scenario, result, path: Path, force_limit_N=None) -> dict:
@@ -211,7 +211,7 @@ def scan_human_summary(out: dict, scenario) -> str:
         lines.append("contact losses: none")
     tank = (
         f"tank minimum {_n(out['tank_min_J'])} J (floor {c['tank_floor_J']:g} J)"
-        if out["controller"] in ("vs-cf", "vs-vf")
+        if math.isfinite(c["tank_floor_J"])
         else "no energy tank (" + out["controller"] + ")"
     )
     lines.append(
@@ -225,7 +225,6 @@ def scan_human_summary(out: dict, scenario) -> str:
 
 
 __all__ = [
-    "DEFAULT_FORCE_LIMIT_N",
     "MAX_EXTRA_DURATION_S",
     "SCAN_DESCRIPTION",
     "campaign_force_limit",
