@@ -6,10 +6,14 @@ every ``--steps`` seconds along the log, combined by mean / rms / median,
 and prints C2's per-log metric (Spearman, R^2, last/first; thresholds of
 :mod:`vic_drake.analysis.claims.thresholds`) on the log as recorded and
 trimmed: 1-3 s dropped after the first in-contact sample, 1-3 s dropped at
-the end, the first 1-2 palpation cycles dropped.
+the end, the first 1-2 palpation cycles dropped. Each row names the approach
+cycles the curve skipped (``skip_approach``); "first, approach kept" is the
+curve counted from the first in-contact sample. ``--settle-fractions``
+prints, per log as recorded, the cycles skipped and the verdict at each
+settle fraction of :func:`~vic_drake.estimation.palpation.approach.palpation_start`.
 
     python benchmarks/c2_placements.py [--data-dir DIR] [--sim-dir REPRODUCE_OUT]
-        [--steps 0.5,0.25,0.1] [--no-trims]
+        [--steps 0.5,0.25,0.1] [--no-trims] [--settle-fractions 0.05,0.1,0.2]
 
 ``--sim-dir``: a ``vic-drake reproduce`` output folder holding
 ``logs/palpation_sim*.parquet`` (stage offline_sim); its relaxing-tissue and
@@ -90,8 +94,9 @@ def row(data: PalpationData, **kw) -> str:
     c = residual_vs_palpation_time(data, **kw)
     d, ok = c2_decay((c.window_s, c.relative))
     r5 = float(np.interp(5.0, c.window_s, c.relative))
+    skipped = "-" if c.approach is None else c.approach.cycles_skipped
     return (
-        f"{'pass' if ok else 'FAIL'} rho {d['spearman']:+.2f} R2 {d['r2']:.2f} "
+        f"skip {skipped} {'pass' if ok else 'FAIL'} rho {d['spearman']:+.2f} R2 {d['r2']:.2f} "
         f"last/first {d['ratio_last_first']:.2f} tau {d['tau_s']:5.1f} s | "
         f"r(0.5 s) {c.relative[0]:.4f} r(5 s) {r5:.4f} r(all) {c.relative[-1]:.4f}"
     )
@@ -103,12 +108,23 @@ def main() -> None:
     parser.add_argument("--sim-dir", default=None)
     parser.add_argument("--steps", default="0.5,0.25,0.1")
     parser.add_argument("--no-trims", action="store_true")
+    parser.add_argument("--settle-fractions", default=None)
     args = parser.parse_args()
     data_dir = resolve_data_dir(args.data_dir)
     logs = real_logs(data_dir) if has_data(data_dir) else {}
     if args.sim_dir:
         logs.update(sim_logs(Path(args.sim_dir), data_dir))
-    methods = {"first": dict(start_step_s=None)}
+    if args.settle_fractions:
+        fractions = [float(f) for f in args.settle_fractions.split(",")]
+        for name, (data, hz) in logs.items():
+            print(f"== {name} ({hz:g} Hz): settle fraction -> cycles skipped, C2")
+            for f in fractions:
+                print(f"  {f:<5g} {row(data, settle_fraction=f)}")
+        return
+    methods = {
+        "first": dict(start_step_s=None),
+        "first, approach kept": dict(start_step_s=None, skip_approach=False),
+    }
     for step in (float(s) for s in args.steps.split(",")):
         for average in ("mean", "rms", "median"):
             methods[f"{average} {step:g} s"] = dict(start_step_s=step, average=average)

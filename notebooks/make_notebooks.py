@@ -86,7 +86,10 @@ plot_table_i(comparison)"""
         ),
         new_markdown_cell(
             "## Fig. 3: residual against palpation time\n\n"
-            "Fit on the first T seconds, evaluate on the whole log. The paper chose 5 s."
+            "Fit on the first T seconds of the palpation, evaluate on the whole "
+            "palpation. The palpation starts after the approach: the first cycles, "
+            "in which the probe still sinks towards its operating depth, are left "
+            "out. The paper chose 5 s."
         ),
         new_code_cell(
             """\
@@ -94,6 +97,7 @@ from vic_drake.analysis.claims import residual_decay
 from vic_drake.reproduce.plots.offline import plot_residual_vs_time
 
 curve = residual_vs_palpation_time(shift(data, comparison.lag_s))
+print(f"approach: {curve.approach.cycles_skipped} cycles skipped")
 print(residual_decay(curve.window_s, curve.relative))
 plot_residual_vs_time(curve)"""
         ),

@@ -1,8 +1,8 @@
 """Fig. 3: the fit residual against palpation time, and its exponential fit.
 
 :func:`residual_vs_palpation_time` fits Hunt-Crossley on windows of each
-length (from the first in-contact sample, or placed all along one aligned
-log and averaged), scoring each fit on the whole log; :func:`fit_exponential` fits
+length (from the palpation's first sample, after the approach, or placed
+all along one aligned log and averaged), scoring each fit on the whole log; :func:`fit_exponential` fits
 r(t) = a exp(-t / tau) + c to the resulting curve.
 """
 
@@ -15,6 +15,11 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from vic_drake.errors import VicDrakeError
+from vic_drake.estimation.palpation.approach import (
+    DEFAULT_SETTLE_FRACTION,
+    PalpationStart,
+    palpation_start,
+)
 from vic_drake.estimation.palpation.data import (
     DEFAULT_INDENTER_MASS_KG,
     DEFAULT_MIN_FORCE_N,
@@ -73,8 +78,11 @@ class ResidualCurve:
         beta: exponent used.
         n_windows: (k,) placements averaged at each length.
         start_step_s: spacing of the placements' starts, s; None for one
-            window per length at the first in-contact sample.
+            window per length at the palpation's first sample.
         average: how the placements were combined (:data:`AVERAGES`).
+        approach: where the palpation starts after the first in-contact
+            sample (:func:`~vic_drake.estimation.palpation.approach.palpation_start`);
+            ``window_s`` counts from there. None when the approach is kept.
     """
 
     window_s: np.ndarray
@@ -87,6 +95,7 @@ class ResidualCurve:
     n_windows: np.ndarray
     start_step_s: float | None
     average: str
+    approach: PalpationStart | None = None
 
 
 def fit_exponential(t_s, r, *, min_tau_s: float | None = None) -> ExponentialFit | None:
@@ -153,7 +162,7 @@ def _check_start_step(start_step_s) -> float | None:
 
 
 def _window_starts(T: float, total: float, step: float | None) -> np.ndarray:
-    """Start times (s after the first in-contact sample) of the windows of
+    """Start times (s after the palpation's first sample) of the windows of
     length ``T`` that lie inside a log of ``total`` in-contact seconds."""
     if step is None or T >= total:
         return np.zeros(1)
@@ -169,14 +178,21 @@ def residual_vs_palpation_time(
     derivative_window_s: float = DEFAULT_DERIVATIVE_WINDOW_S,
     start_step_s: float | None = None,
     average: str = "mean",
+    skip_approach: bool = True,
+    settle_fraction: float = DEFAULT_SETTLE_FRACTION,
 ) -> ResidualCurve:
     """Relative residual against palpation time (Fig. 3 of the paper).
 
+    The palpation starts where its approach ends (``skip_approach``, the
+    default): the whole cycles in which the probe still sinks towards its
+    operating depth are left out of the fits and of the scoring
+    (:func:`~vic_drake.estimation.palpation.approach.palpation_start`); a
+    log with no clear oscillation keeps all its samples.
     For each window length T, kappa and lam are fitted on the in-contact
-    samples within T seconds of the first in-contact sample (the default,
+    samples within T seconds of the palpation's first sample (the default,
     ``start_step_s=None``) or, with ``start_step_s``, on every window
     [s, s + T] that fits in the log, with starts s every ``start_step_s``
-    seconds from the first in-contact sample. The residual of each window's
+    seconds from the palpation's first sample. The residual of each window's
     parameters is evaluated on ALL in-contact samples of the log (relative
     residual as defined in :mod:`vic_drake.estimation.palpation.fits`); with
     several placements the curve holds their mean (``average``), the
@@ -194,9 +210,13 @@ def residual_vs_palpation_time(
             steps up to 10 s, then 2 s steps).
         start_step_s: spacing of the window starts, s (e.g.
             :data:`DEFAULT_START_STEP_S`); None (default) places one window
-            per length, at the first in-contact sample.
+            per length, at the palpation's first sample.
         average: how the placements' residuals (and parameters) are
             combined: "mean", "rms" or "median" (see :data:`AVERAGES`).
+        skip_approach: leave out the approach (default); False counts from
+            the first in-contact sample.
+        settle_fraction: when the approach is over (see
+            :data:`~vic_drake.estimation.palpation.approach.DEFAULT_SETTLE_FRACTION`).
     """
     beta = _check_beta(beta)
     mass = _check_mass(indenter_mass_kg)
@@ -207,13 +227,25 @@ def residual_vs_palpation_time(
         )
     combine = AVERAGES[average]
     central = np.median if average == "median" else np.mean
-    p = _problem(
-        data,
+    options = dict(
         derivative_window_s=derivative_window_s,
         min_penetration_m=DEFAULT_MIN_PENETRATION_M,
         min_force_N=DEFAULT_MIN_FORCE_N,
         spike_sigma=DEFAULT_SPIKE_SIGMA,
     )
+    p = _problem(data, **options)
+    approach = None
+    if skip_approach:
+        approach = palpation_start(
+            data.t_s,
+            p.eps,
+            p.mask,
+            z_target_m=data.z_target_m,
+            settle_fraction=settle_fraction,
+        )
+        if approach.cycles_skipped:
+            t_start = data.t_s[np.argmax(p.mask)] + approach.start_s
+            p = _problem(data, sample_mask=data.t_s >= t_start - 1e-9, **options)
     t_contact = data.t_s - data.t_s[np.argmax(p.mask)]
     total = float(t_contact[p.mask][-1])
     if windows_s is None:
@@ -282,4 +314,5 @@ def residual_vs_palpation_time(
         n_windows=np.array(out["count"]),
         start_step_s=step,
         average=average,
+        approach=approach,
     )

@@ -158,7 +158,7 @@ def plot_residual_vs_time(
             )
     ax.axvline(5.0, color="k", ls="--", alpha=0.4, label="paper's 5 s")
     ax.set_xlabel("palpation time [s]")
-    ax.set_ylabel("relative residual on the whole log")
+    ax.set_ylabel("relative residual on the whole palpation")
     if title:
         ax.set_title(title)
     ax.legend(fontsize="small")

@@ -99,10 +99,17 @@ def offline_fits(ctx: RunContext, logs: dict, label: str) -> dict:
         plot_beta_sweep({n: c.sweep for n, c in comparisons.items()}),
         f"beta_sweep_{label}.png",
     )
+    skipped = ", ".join(
+        f"{n} {c.approach.cycles_skipped}"
+        for n, c in curves.items()
+        if c.approach is not None
+    )
     ctx.add_figure(
         f"Fig. 3 ({label}): residual vs palpation time",
-        "Relative residual on the whole log of the parameters fitted on the "
-        "first T seconds, with an exponential fit (paper's Fig. 3).",
+        "Relative residual on the whole palpation of the parameters fitted on its "
+        "first T seconds, with an exponential fit (paper's Fig. 3). The palpation "
+        "starts after the approach: the whole cycles in which the probe still sank "
+        f"towards its operating depth are left out (cycles skipped: {skipped}).",
         plot_residual_vs_time(curves),
         f"fig3_residual_vs_time_{label}.png",
     )
