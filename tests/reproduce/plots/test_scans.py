@@ -50,3 +50,24 @@ def test_plot_functions_return_figures_jupyter_shows():
     fig = plot_fig6({"vs-vf": _scan(True, True)})
     png = fig._repr_png_()
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000
+
+
+def _legend(ax):
+    legend = ax.get_legend()
+    return [] if legend is None else [t.get_text() for t in legend.get_texts()]
+
+
+def test_the_force_bound_is_drawn_only_where_it_binds():
+    """Issue: CS's and CF's legends listed "-F_min sim" for a line that had no
+    visible point: the bound is 0 in the first sample (the controller's
+    output before its first tick) and 15 N after."""
+    from vic_drake.reproduce.plots.scans import plot_fig6
+
+    unbound = _scan(False, False)
+    unbound.loc[0, "force_min_z_N"] = 0.0
+    bound = _scan(True, True)
+    bound["force_min_z_N"] = np.where(bound["t_s"] > 2.0, -9.0, -15.0)
+    fig = plot_fig6({"cs": unbound, "vs-vf": bound})
+    grid = np.array(fig.axes).reshape(-1, 2)
+    assert "-F_min sim" not in _legend(grid[0, 0])
+    assert "-F_min sim" in _legend(grid[0, 1])

@@ -124,10 +124,12 @@ def _scan_column(
                     label="F_ref sim",
                 )
             f_min = -_col(sim, "force_min_z_N") if _has(sim, "force_min_z_N") else None
-            if f_min is not None and np.any(f_min < 14.9):
+            # A bound of 0 is the controller's output before its first tick.
+            binding = None if f_min is None else (f_min > 0.0) & (f_min < 14.9)
+            if binding is not None and binding.any():
                 ax.plot(
                     t,
-                    np.where(f_min < 14.9, f_min, np.nan),
+                    np.where(binding, f_min, np.nan),
                     ":",
                     color="tab:red",
                     lw=1.0,
