@@ -124,6 +124,29 @@ def main(argv: list[str] | None = None) -> int:
                 print(f"vic-drake: error: {exc}", file=sys.stderr)
                 return 2
             print(f"vic-drake: note: {exc} (commands will not run)", file=sys.stderr)
+    try:
+        # Ctrl-C is caught from here on: building the parser imports the
+        # commands' modules (numpy, scipy), which takes most of a second.
+        return _run(argv)
+    except KeyboardInterrupt:
+        print("vic-drake: interrupted", file=sys.stderr)
+        if argv is None:
+            # Run as the program: leave now. The run's files are closed, its
+            # worker processes stopped; the interpreter's teardown of pydrake
+            # would add 1-2 s (docs/decisions.md, "Output paths, data folder, Ctrl-C, run marker").
+            # multiprocessing's own exit step first, so its semaphores are
+            # released (else its resource tracker warns about leaks).
+            import multiprocessing.util
+
+            multiprocessing.util._exit_function()
+            sys.stdout.flush()
+            sys.stderr.flush()
+            os._exit(130)
+        return 130
+
+
+def _run(argv: list[str] | None) -> int:
+    """Parses the command line and runs its command; errors as exit status 2."""
     parser = build_parser()
     _check_command_name(parser, sys.argv[1:] if argv is None else argv)
     args, extras = parser.parse_known_args(argv)
@@ -140,21 +163,6 @@ def main(argv: list[str] | None = None) -> int:
     except VicDrakeError as exc:
         print(f"vic-drake: error: {exc}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print("vic-drake: interrupted", file=sys.stderr)
-        if argv is None:
-            # Run as the program: leave now. The run's files are closed, its
-            # worker processes stopped; the interpreter's teardown of pydrake
-            # would add 1-2 s (docs/decisions.md, "Output paths, data folder, Ctrl-C, run marker").
-            # multiprocessing's own exit step first, so its semaphores are
-            # released (else its resource tracker warns about leaks).
-            import multiprocessing.util
-
-            multiprocessing.util._exit_function()
-            sys.stdout.flush()
-            sys.stderr.flush()
-            os._exit(130)
-        return 130
 
 
 if __name__ == "__main__":

@@ -164,3 +164,16 @@ def test_a_misspelt_command_names_the_closest(capsys):
     err = capsys.readouterr().err
     assert "unknown command 'reproduc' (did you mean reproduce?)" in err
     assert "compare-real" in err  # The commands are listed.
+
+
+def test_ctrl_c_while_the_commands_load_is_no_traceback(monkeypatch, capsys):
+    """Issue: a Ctrl-C in the first second (the parser imports the commands'
+    modules) printed a traceback; it now ends as any other interruption."""
+    from vic_drake import cli
+
+    def interrupted():
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli, "build_parser", interrupted)
+    assert cli.main(["campaign", "--help"]) == 130
+    assert capsys.readouterr().err.strip() == "vic-drake: interrupted"
