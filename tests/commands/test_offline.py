@@ -188,6 +188,7 @@ def test_fit_palpation_human_summary(capsys, data_dir):
         and "sensor lag 50.0 ms" in out
     )
     assert "residual vs palpation time" in out and "exp(-T /" in out
+    assert "after the approach (3 cycles)" in out
 
 
 @pytest.mark.realdata

@@ -219,9 +219,11 @@ def _fit_palpation(args: argparse.Namespace) -> int:
         )
         f = curve.exp_fit
         if f is not None:
+            skipped = curve.approach.cycles_skipped if curve.approach else 0
             lines.append(
-                "residual vs palpation time (Fig. 3, beta = 1.35, fit on the first T s, "
-                f"scored on the whole log): {f.a:.3g} exp(-T / {f.tau_s:.3g} s) + {f.c:.3g}"
+                "residual vs palpation time (Fig. 3, beta = 1.35, fit on the first T s "
+                f"after the approach ({skipped} cycles), scored on the whole palpation): "
+                f"{f.a:.3g} exp(-T / {f.tau_s:.3g} s) + {f.c:.3g}"
             )
     lines.append(_RELATIVE_HELP)
     emit(out, args.json, "\n".join(lines))
