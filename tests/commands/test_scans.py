@@ -306,3 +306,63 @@ def test_compare_real_finds_a_relative_bag_in_the_data_dir(
     argv = ["compare-real", "experiments/test_tracking5", "--data-dir", str(data_dir)]
     assert main([*argv, "--duration", "2.5", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["controller"] == "vs-cf"
+
+
+def _compare_real_result(**changes):
+    out = {
+        "controller": "cs",
+        "duration_s": 19.9,
+        "rtf": 4.7,
+        "force_rmse_N": 0.729,
+        "force_peak_err_N": 0.36,
+        "z_rmse_mm": 0.51,
+        "kz_corr": None,
+        "phantom_motion_significance": 0.0,
+        "phantom_motion_sigma_median_mm": 2.8,
+        "phantom_motion_max_mm": 8.6,
+        "phantom_motion_replayed": False,
+        "phantom_motion_reference": "phantom map",
+        "surface_offset_source": "placement",
+        "surface_offset_mm": 1.76,
+        "surface_placement_offset_mm": 1.76,
+        "surface_placement_slope_mm_per_m": 16.6,
+        "contact_loss_total_sim_s": 0.0,
+        "contact_loss_total_real_s": 0.0,
+        "contact_loss_overlap_s": 0.0,
+        "force_peak_sim_N": 9.71,
+        "force_peak_real_N": 9.40,
+    }
+    out.update(changes)
+    return out
+
+
+def test_compare_real_says_what_it_assumed_of_the_phantom():
+    """Issue: the summary in words gave the scores only; whether the phantom was
+    taken to rest or to move, where its surface was put and the contact loss
+    were in the JSON alone (and a resting log's 8.6 mm "motion" read as news)."""
+    from vic_drake.commands.scans import compare_real_summary
+
+    rest = compare_real_summary("log", _compare_real_result())
+    assert "phantom: at rest (its estimated motion is noise" in rest
+    assert "8.6" not in rest
+    assert "offset +1.76 mm, tilt +16.6 mm/m" in rest
+    assert "contact lost: never, in either" in rest
+    assert "peak force: 9.71 N simulated, 9.40 N real" in rest
+    moved = compare_real_summary(
+        "log",
+        _compare_real_result(
+            phantom_motion_replayed=True,
+            phantom_motion_significance=0.76,
+            phantom_motion_max_mm=31.9,
+            phantom_motion_reference="nominal log",
+            surface_offset_source="rig default",
+            surface_offset_mm=3.75,
+            contact_loss_total_sim_s=0.344,
+            contact_loss_total_real_s=0.426,
+            contact_loss_overlap_s=0.344,
+        ),
+    )
+    assert "phantom: moved, up to 31.90 mm (76% of the samples beyond 3 sigma" in moved
+    assert "against the nominal log); its motion is replayed" in moved
+    assert "surface: the map offset by +3.75 mm (rig default)" in moved
+    assert "contact lost: 0.34 s simulated, 0.43 s real, 0.34 s of it" in moved

@@ -302,15 +302,64 @@ def run_compare_real(args: argparse.Namespace) -> int:
         plot_comparison(sim, real, title=Path(args.bag_dir).name, save_path=args.plot)
     ordered = {k: out.get(k) for k in COMPARE_REAL_KEYS}
     ordered.update({k: v for k, v in out.items() if k not in ordered})
-    kz = "n/a" if ordered["kz_corr"] is None else f"{ordered['kz_corr']:.3f}"
-    human = (
-        f"{Path(args.bag_dir).name} ({ordered['controller']}, {ordered['duration_s']:.1f} s, "
-        f"RTF {ordered['rtf']:.2f}): force RMSE {ordered['force_rmse_N']:.3f} N, "
-        f"peak error {ordered['force_peak_err_N']:.3f} N, z RMSE {ordered['z_rmse_mm']:.2f} mm, "
-        f"K_z corr {kz}"
-    )
-    emit(ordered, args.json, human)
+    emit(ordered, args.json, compare_real_summary(Path(args.bag_dir).name, ordered))
     return 0
+
+
+def _mm(value, sign: bool = False) -> str:
+    return "?" if value is None else f"{value:{'+' if sign else ''}.2f} mm"
+
+
+def compare_real_summary(name: str, out: dict) -> str:
+    """compare-real's result in words: the scores, then what the simulation
+    assumed of the phantom (at rest or moved, where its surface is) and the
+    contact loss and peaks it is judged on."""
+    kz = "n/a" if out.get("kz_corr") is None else f"{out['kz_corr']:.3f}"
+    lines = [
+        f"{name} ({out['controller']}, {out['duration_s']:.1f} s, RTF {out['rtf']:.2f}): "
+        f"force RMSE {out['force_rmse_N']:.3f} N, peak error "
+        f"{out['force_peak_err_N']:.3f} N, z RMSE {out['z_rmse_mm']:.2f} mm, K_z corr {kz}"
+    ]
+    share = out.get("phantom_motion_significance")
+    sigma = out.get("phantom_motion_sigma_median_mm")
+    beyond = "" if share is None else f"{share:.0%} of the samples beyond 3 sigma"
+    if out.get("phantom_motion_replayed"):
+        lines.append(
+            f"  phantom: moved, up to {_mm(out.get('phantom_motion_max_mm'))} "
+            f"({beyond}, sigma {_mm(sigma)}; against the "
+            f"{out.get('phantom_motion_reference')}); its motion is replayed"
+        )
+    else:
+        lines.append(
+            f"  phantom: at rest (its estimated motion is noise: {beyond}, "
+            f"sigma {_mm(sigma)})"
+        )
+    source = out.get("surface_offset_source")
+    if source == "placement":
+        lines.append(
+            "  surface: the map placed by the log's in-contact surface, offset "
+            f"{_mm(out.get('surface_placement_offset_mm'), True)}, tilt "
+            f"{out.get('surface_placement_slope_mm_per_m', 0.0):+.1f} mm/m along the track"
+        )
+    else:
+        lines.append(
+            f"  surface: the map offset by {_mm(out.get('surface_offset_mm'), True)} "
+            f"({source})"
+        )
+    sim_loss = out.get("contact_loss_total_sim_s") or 0.0
+    real_loss = out.get("contact_loss_total_real_s") or 0.0
+    if sim_loss or real_loss:
+        lines.append(
+            f"  contact lost: {sim_loss:.2f} s simulated, {real_loss:.2f} s real, "
+            f"{out.get('contact_loss_overlap_s') or 0.0:.2f} s of it at the same time"
+        )
+    else:
+        lines.append("  contact lost: never, in either")
+    lines.append(
+        f"  peak force: {out['force_peak_sim_N']:.2f} N simulated, "
+        f"{out['force_peak_real_N']:.2f} N real"
+    )
+    return "\n".join(lines)
 
 
 def run_scan_command(args: argparse.Namespace) -> int:
