@@ -93,23 +93,41 @@ def test_every_drake_solver_runs_the_program(solver):
         )
 
 
-def test_a_force_row_out_of_reach_of_an_underflowing_error_is_infeasible(osqp):
-    # Found by the oracle test: e_z ~ 1e-309 cannot make the z force reach
-    # F_min - D e_dot = 0.40 N with any K of the box. The exact solver divided
-    # by it (-inf) and called K_min optimal; the program got bounds beyond
-    # OSQP's infinity and failed in its setup.
+#: Underflowing errors the oracle test found: (e_z, e_dot_z, D_z, R, tank a_z).
+#: e_z ~ 1e-309 cannot make the z force reach F_min - D e_dot = 0.40 N with
+#: any K of the box: the exact solver divided by it (-inf) and called K_min
+#: optimal, the program got bounds beyond OSQP's infinity and failed in its
+#: setup. With e_z = +-5e-324 (found on Python 3.12) e s is 0.0 and the
+#: program divided by it (ZeroDivisionError).
+UNDERFLOWING_ERRORS = [
+    (
+        -2.225073858507203e-309,
+        -0.046875,
+        29.895317559778487,
+        1e-05,
+        1.04300337117524e-310,
+    ),
+    (5e-324, -0.03125, 32.02639767441852, 10.0, -0.0),
+    (-5e-324, -0.03125, 32.02639767441852, 10.0, -0.0),
+]
+
+
+@pytest.mark.parametrize("e_z, e_dot_z, d_z, r, a_z", UNDERFLOWING_ERRORS)
+def test_a_force_row_out_of_reach_of_an_underflowing_error_is_infeasible(
+    osqp, e_z, e_dot_z, d_z, r, a_z
+):
     p = StiffnessQpProblem(
-        e=(0.0, 0.0, -2.225073858507203e-309),
-        e_dot=(0.0, 0.0, -0.046875),
-        damping=(24.491198419023927, 24.491198419023927, 29.895317559778487),
+        e=(0.0, 0.0, e_z),
+        e_dot=(0.0, 0.0, e_dot_z),
+        damping=(24.491198419023927, 24.491198419023927, d_z),
         force_ref=(0.0, 0.0, -0.0),
         force_min=(-15.0, -15.0, -1.0),
         force_max=(15.0, 15.0, 15.0),
         stiffness_min=(300.0, 300.0, 100.0),
         stiffness_max=(1000.0, 1000.0, 1000.0),
         q_weight=(3200.0, 3200.0, 3200.0),
-        r_weight=(1e-05, 1e-05, 1e-05),
-        tank_a=(0.0, 0.0, 1.04300337117524e-310),
+        r_weight=(r, r, r),
+        tank_a=(0.0, 0.0, a_z),
         tank_lb_energy=-153.6,
         tank_lb_power=-0.1,
     )

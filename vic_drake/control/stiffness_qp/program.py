@@ -269,9 +269,19 @@ def _axis_rows(ei, edi, di, fri, fmin, fmax, kmin, kmax, q, r, unit, free):
         return None
     else:  # e s kk in [f_lo_row, f_hi_row], divided by e s.
         c = ei * s
-        lo_f, hi_f = (
-            (f_lo_row / c, f_hi_row / c) if c > 0.0 else (f_hi_row / c, f_lo_row / c)
-        )
+        if c != 0.0:
+            lo_f, hi_f = (
+                (f_lo_row / c, f_hi_row / c)
+                if c > 0.0
+                else (f_hi_row / c, f_lo_row / c)
+            )
+        else:  # e s underflows (|e| ~ 1e-323): divide by e, then by s.
+            lo_k, hi_k = (
+                (f_lo_row / ei, f_hi_row / ei)
+                if ei > 0.0
+                else (f_hi_row / ei, f_lo_row / ei)
+            )
+            lo_f, hi_f = lo_k / s, hi_k / s
         # A row that no K of the box meets is infeasible, as the exact oracle
         # decides (the solver would get bounds beyond its infinity).
         k_lo, k_hi = max(kmin, lo_f * s), min(kmax, hi_f * s)
