@@ -160,3 +160,47 @@ def test_controller_refuses_the_slope_surface_without_the_dither():
             stiffness_source="online",
             estimator=OnlineEstimatorParams(method="ekf", surface_from_slope=True),
         )
+
+
+@pytest.mark.parametrize("mode", ["tracker", "direct"])
+def test_direct_slope_mode_reads_the_qp_stiffness(mode):
+    params = ControllerParams(
+        qp=StiffnessQpParams(solver="exact"),
+        reference=ReferenceParams(
+            controller="vs-vf",
+            eps_d_m=EPS_D,
+            penetration_dither_m=3e-4,
+            penetration_dither_hz=3.0,
+        ),
+    )
+    estimator = OnlineEstimatorParams(
+        method="ekf",
+        surface_from_slope=True,
+        surface_walk_m_per_sqrt_s=0.0,
+        slope_kappa_mode=mode,
+    )
+    diagram = MakeVariableImpedanceController(
+        params, phantom=None, stiffness_source="online", estimator=estimator
+    )
+    port = diagram.GetSubsystemByName("tissue_estimator").get_stiffness_input_port()
+    # "direct" relaxes its held kappa while K_z is at K_max: the estimator
+    # reads the QP's K (connected: the ticks evaluate it).
+    assert (port is not None) == (mode == "direct")
+    context = _run_ticks(diagram, 20)
+    est = diagram.GetOutputPort("tissue_estimate").Eval(context)
+    assert np.all(np.isfinite(est[:5]))
+
+
+def test_estimator_stiffness_input_needs_the_slope_fit():
+    from vic_drake.systems.online_estimator import OnlineEstimatorSystem
+
+    with pytest.raises(VicDrakeError, match="stiffness_max_z is for"):
+        OnlineEstimatorSystem(
+            OnlineEstimatorParams(method="ekf"), period_s=0.002, stiffness_max_z=1e3
+        )
+    with pytest.raises(VicDrakeError, match="stiffness_max_z must be > 0"):
+        OnlineEstimatorSystem(
+            OnlineEstimatorParams(method="ekf", surface_from_slope=True),
+            period_s=0.002,
+            stiffness_max_z=0.0,
+        )

@@ -15,8 +15,10 @@ well):
 - "..._dither": the same with the penetration dither on
   (:data:`DITHER_M` at :data:`DITHER_HZ`); "online_dither" also takes its
   surface from the tissue's slope under the dithered tip
-  (``online_estimator.surface_from_slope``, no EKF surface state). The map
-  runs with the dither show what the dither alone costs.
+  (``online_estimator.surface_from_slope``, no EKF surface state) in the
+  fit's "direct" mode (``slope_kappa_mode``: kappa from the fit, held,
+  relaxed towards the force while K_z is saturated). The map runs with the
+  dither show what the dither alone costs.
 
 Scores over the scan window (:func:`vic_drake.analysis.contact.scan_window`):
 
@@ -102,6 +104,7 @@ def comparison_scenario(
         if source == "online":  # The surface from the slope, no EKF surface state.
             s.online_estimator.surface_from_slope = True
             s.online_estimator.surface_walk_m_per_sqrt_s = 0.0
+            s.online_estimator.slope_kappa_mode = "direct"
     return s.validate()
 
 

@@ -35,6 +35,9 @@ _X, _Y, _Z = range(MEASURED_POSITION.start, MEASURED_POSITION.stop)
 _VZ = MEASURED_VELOCITY.start + 2
 _FZ = MEASURED_FORCE.start + 2
 
+#: K_z counts as at its bound from this fraction below it.
+SATURATION_REL_TOL = 1e-3
+
 #: Index of each field in the "estimate" output.
 ESTIMATE_SIZE = len(OUTPUT_FIELDS)
 _I = {name: i for i, name in enumerate(OUTPUT_FIELDS)}
@@ -54,6 +57,10 @@ class OnlineEstimatorSystem(LeafSystem):
             is latched at first contact (and corrected by the EKF when its
             surface state is on), or, with ``surface_map`` (a Phantom), read
             from the map under the probe.
+        stiffness (3): the controller's stiffness K, N/m (only with
+            ``stiffness_max_z``): the slope fit's "direct" mode relaxes its
+            held kappa while K_z is at ``stiffness_max_z``
+            (:mod:`vic_drake.estimation.online.slope`).
 
     Output ports (state: the last tick's estimate):
         estimate (7): :data:`vic_drake.estimation.online.OUTPUT_FIELDS`.
@@ -71,6 +78,7 @@ class OnlineEstimatorSystem(LeafSystem):
         period_s: float,
         surface_input: bool = True,
         surface_map=None,
+        stiffness_max_z: float | None = None,
     ):
         super().__init__()
         if not isinstance(params, OnlineEstimatorParams):
@@ -97,6 +105,18 @@ class OnlineEstimatorSystem(LeafSystem):
         self._surface_lookup = (
             None if surface_map is None else surface_map.point_lookup()
         )
+        if stiffness_max_z is not None and not self._params.surface_from_slope:
+            raise VicDrakeError(
+                "stiffness_max_z is for the estimator's surface_from_slope; it is off"
+            )
+        self._stiffness_port = None
+        if stiffness_max_z is not None:
+            if not (math.isfinite(stiffness_max_z) and stiffness_max_z > 0.0):
+                raise VicDrakeError(
+                    f"stiffness_max_z must be > 0; got {stiffness_max_z!r}"
+                )
+            self._stiffness_port = self.DeclareVectorInputPort("stiffness", 3)
+            self._k_saturated = stiffness_max_z * (1.0 - SATURATION_REL_TOL)
         self._filter = self.DeclareDiscreteState(np.asarray(state0, float))
         self._estimate = self.DeclareDiscreteState(np.asarray(est0, float))
         self.DeclarePeriodicDiscreteUpdateEvent(float(period_s), 0.0, self._update)
@@ -132,20 +152,21 @@ class OnlineEstimatorSystem(LeafSystem):
         # Drake fills discrete_state with the current state before calling
         # this handler: the filter state is read from it and written in place.
         state = discrete_state.value(self._filter).tolist()
-        state, est = self._step(
-            state,
-            context.get_time(),
-            m[_Z],
-            m[_VZ],
-            -m[_FZ],
-            s,
-            self._params,
-        )
+        args = (state, context.get_time(), m[_Z], m[_VZ], -m[_FZ], s, self._params)
+        if self._stiffness_port is None:
+            state, est = self._step(*args)
+        else:
+            k_z = float(self._stiffness_port.Eval(context)[2])
+            state, est = self._step(*args, k_z >= self._k_saturated)
         discrete_state.get_mutable_value(self._filter)[:] = state
         discrete_state.get_mutable_value(self._estimate)[:] = est
 
     def get_measurement_input_port(self):
         return self._measurement_port
+
+    def get_stiffness_input_port(self):
+        """The "stiffness" input (None without ``stiffness_max_z``)."""
+        return self._stiffness_port
 
     def get_estimate_output_port(self):
         return self._ports["estimate"]
@@ -186,6 +207,7 @@ class EkfEstimatorSystem(OnlineEstimatorSystem):
 
 __all__ = [
     "ESTIMATE_SIZE",
+    "SATURATION_REL_TOL",
     "EkfEstimatorSystem",
     "OnlineEstimatorSystem",
     "RlsEstimatorSystem",

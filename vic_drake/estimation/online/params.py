@@ -13,6 +13,9 @@ from vic_drake.paper import BEST_BETA, CONTACT_THRESHOLD_N
 
 #: The online estimators, by name.
 ONLINE_METHODS = ("rls", "ekf")
+#: How the slope fit's surface is formed
+#: (:mod:`~vic_drake.estimation.online.slope`).
+SLOPE_KAPPA_MODES = ("tracker", "direct")
 
 
 def _number(name: str, value, *, low=None, low_open=False, high=None) -> float:
@@ -95,7 +98,16 @@ class OnlineEstimatorParams:
         slope_max_rel_std: ... and the relative standard error of the
             slope is at most this.
         slope_surface_time_s: time scale of the filter that tracks the
-            fit's surface (1 / its natural frequency), s.
+            fit's surface (1 / its natural frequency), s ("tracker" mode).
+        slope_kappa_mode: "tracker" (the fit's surface through a slow
+            filter; kappa follows the force) or "direct" (kappa from the
+            fit's valid solves, held between them, relaxed towards the
+            force at the held surface while the stiffness is saturated;
+            the surface z + (F / kappa)^(1 / beta)). See
+            :mod:`~vic_drake.estimation.online.slope`.
+        slope_kappa_max_rate_per_s: "direct" mode: ln kappa moves at most
+            this fast, 1/s (the tissue under the probe at scan speed
+            changes its ln kappa by at most ~0.5/s on both phantoms).
     """
 
     method: str = "rls"
@@ -126,6 +138,8 @@ class OnlineEstimatorParams:
     slope_min_motion_m: float = 5e-5
     slope_max_rel_std: float = 0.05
     slope_surface_time_s: float = 0.5
+    slope_kappa_mode: str = "tracker"
+    slope_kappa_max_rate_per_s: float = 1.0
 
     def __post_init__(self):
         self.validate()
@@ -170,6 +184,17 @@ class OnlineEstimatorParams:
         _number(
             "slope_surface_time_s", self.slope_surface_time_s, low=0.0, low_open=True
         )
+        if self.slope_kappa_mode not in SLOPE_KAPPA_MODES:
+            raise VicDrakeError(
+                "OnlineEstimatorParams.slope_kappa_mode must be one of "
+                f"{list(SLOPE_KAPPA_MODES)}; got {self.slope_kappa_mode!r}"
+            )
+        _number(
+            "slope_kappa_max_rate_per_s",
+            self.slope_kappa_max_rate_per_s,
+            low=0.0,
+            low_open=True,
+        )
         if not isinstance(self.surface_from_slope, bool):
             raise VicDrakeError(
                 "OnlineEstimatorParams.surface_from_slope must be true or false; "
@@ -188,4 +213,4 @@ class OnlineEstimatorParams:
         return self
 
 
-__all__ = ["ONLINE_METHODS", "OnlineEstimatorParams"]
+__all__ = ["ONLINE_METHODS", "SLOPE_KAPPA_MODES", "OnlineEstimatorParams"]

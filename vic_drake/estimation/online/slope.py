@@ -39,6 +39,24 @@ depth). Its surface ``mean z + eps`` holds at the weighted mean time of
 the data; the output surface tracks it (brought to now with the tracked
 rate) through a second-order filter (see :func:`slope_step`). Everything
 restarts at each loss of contact.
+
+That is the "tracker" mode (``slope_kappa_mode``): the surface is smooth
+and kappa follows the force. The "direct" mode holds kappa instead:
+ln kappa follows the valid solves' F / eps^beta, is held while the solves
+are not valid, and the output surface is ``z + (F / kappa)^(1 / beta)``
+(the EKF downstream then reads that kappa back). A held kappa is a trap
+where the stiffness saturates: the tip stops, no solve is valid again and
+kappa stays where it was while the tissue changes. So while the caller
+says the stiffness is at its bound (``saturated``) and the last solve is
+not valid, ln kappa moves towards ``F / (s_hold - z)^beta``, with s_hold
+the last valid solve's own surface (mean z + eps at its mean time: its
+mean force, free of the dither's damping force). A still tip under a
+saturated stiffness does not move the force with the estimate, so this
+has no feedback loop; where the tip moves, the surface is not held (the
+rib's exit of the measured phantom falls away under a held surface). In
+both cases ln kappa moves at most
+``slope_kappa_max_rate_per_s``: a single biased solve (the fit reads the
+loop's own large motions worst) moves the estimate by a bounded step.
 """
 
 from __future__ import annotations
@@ -83,7 +101,9 @@ _T_MEAN = _Z_MEAN + 1  # its weighted mean time, s
 _S_OUT = _T_MEAN + 1  # the tracked surface, m (NaN: none)
 _V_OUT = _S_OUT + 1  # its rate, m/s
 _KAPPA = _V_OUT + 1  # F / eps^beta of the last valid solve (NaN: none)
-SLOPE_SIZE = _KAPPA + 1
+_LN_KAPPA = _KAPPA + 1  # "direct": the output ln kappa (NaN: none)
+_S_HOLD = _LN_KAPPA + 1  # "direct": the last valid solve's surface, m
+SLOPE_SIZE = _S_HOLD + 1
 #: Index of the tracked surface in the state (:func:`advance`).
 SURFACE = _S_OUT
 
@@ -116,7 +136,7 @@ def slope_initial_state() -> list[float]:
     state = [0.0] * SLOPE_SIZE
     for i in (
         _T_REF, _T_START, _T_LAST, _SLOPE, _REL_STD, _EPS, _Z_MEAN, _T_MEAN, _S_OUT,
-        _KAPPA,
+        _KAPPA, _LN_KAPPA, _S_HOLD,
     ):  # fmt: skip
         state[i] = math.nan
     return state
@@ -161,6 +181,38 @@ def _solve(s: list[float], t: float, p: OnlineEstimatorParams) -> None:
         s[_EPS] = (force / s[_KAPPA]) ** (1.0 / p.beta)
 
 
+def _direct(
+    s: list[float],
+    z: float,
+    force: float,
+    dt: float,
+    saturated: bool,
+    p: OnlineEstimatorParams,
+) -> None:
+    """The "direct" mode's kappa and surface of one sample (in place)."""
+    if not math.isfinite(s[_KAPPA]) or force <= 0.0:
+        return
+    held = s[_LN_KAPPA]
+    valid = s[_VALID] == 1.0
+    eps_hold = s[_S_HOLD] - z
+    if valid:
+        target = math.log(s[_KAPPA])
+    elif saturated and eps_hold > 0.0:  # (False when NaN)
+        target = math.log(force) - p.beta * math.log(eps_hold)
+    else:
+        target = held
+    if math.isnan(held):
+        ln_kappa = target
+    else:
+        bound = p.slope_kappa_max_rate_per_s * dt
+        ln_kappa = min(max(target, held - bound), held + bound)
+    s[_LN_KAPPA] = ln_kappa
+    s[_S_OUT] = z + (force / math.exp(ln_kappa)) ** (1.0 / p.beta)
+    s[_V_OUT] = 0.0
+    if valid:  # The fit's own surface (its mean force: no dither damping).
+        s[_S_HOLD] = s[_Z_MEAN] + s[_EPS]
+
+
 def slope_step(
     state,
     t: float,
@@ -169,6 +221,7 @@ def slope_step(
     force: float,
     params: OnlineEstimatorParams,
     surface_start: float = math.nan,
+    saturated: bool = False,
 ) -> tuple[list[float], SlopeEstimate]:
     """One sample of the fit and of the surface it measures.
 
@@ -193,13 +246,15 @@ def slope_step(
             at or below ``params.contact_threshold_N`` everything restarts.
         params: ``slope_memory_s``, ``slope_min_motion_m``,
             ``slope_surface_time_s``, ``beta``, ``contact_threshold_N``.
-        surface_start: see above, m.
+        surface_start: see above, m ("tracker" mode).
+        saturated: the controller's stiffness is at its bound ("direct"
+            mode: see the module docstring).
 
     Returns:
         (new state, :class:`SlopeEstimate`).
     """
     s = list(state)
-    advance(s, t, z, z_dot, force, params, surface_start)
+    advance(s, t, z, z_dot, force, params, surface_start, saturated)
     return s, _estimate(s)
 
 
@@ -211,6 +266,7 @@ def advance(
     force: float,
     params: OnlineEstimatorParams,
     surface_start: float = math.nan,
+    saturated: bool = False,
 ) -> None:
     """:func:`slope_step` on the state ``s`` in place, without the estimate
     (its surface is ``s[SURFACE]``)."""
@@ -234,7 +290,9 @@ def advance(
     s[_COUNT] += 1.0
     if s[_COUNT] >= SOLVE_EVERY:
         _solve(s, t, p)
-    if math.isfinite(s[_EPS]):
+    if p.slope_kappa_mode == "direct":
+        _direct(s, z, force, dt, saturated, p)
+    elif math.isfinite(s[_EPS]):
         v = s[_V_OUT]
         measured = s[_Z_MEAN] + s[_EPS] + v * (t - s[_T_MEAN])
         if math.isnan(s[_S_OUT]):
