@@ -30,7 +30,7 @@ not digits.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -150,13 +150,28 @@ def _problem(
         min_force_N=min_force_N,
         spike_sigma=spike_sigma,
     )
+    p = _Problem(
+        kin.eps_m, kin.eps_dot_m_per_s, kin.z_ddot_m_per_s2, data.force_N, mask
+    )
+    return _restrict(
+        p, sample_mask, min_penetration_m=min_penetration_m, min_force_N=min_force_N
+    )
+
+
+def _restrict(
+    p: _Problem, sample_mask, *, min_penetration_m: float, min_force_N: float
+) -> _Problem:
+    """``p`` on its samples that ``sample_mask`` keeps (None: all), with at
+    least :data:`MIN_CONTACT_SAMPLES` of them (the thresholds name the
+    contact rule in the error)."""
+    mask = p.mask
     if sample_mask is not None:
         sample_mask = np.asarray(sample_mask, bool)
         if sample_mask.shape != mask.shape:
             raise VicDrakeError(
                 f"sample_mask has shape {sample_mask.shape}; the log has {mask.shape}"
             )
-        mask &= sample_mask
+        mask = mask & sample_mask
     n = int(mask.sum())
     if n < MIN_CONTACT_SAMPLES:
         raise VicDrakeError(
@@ -164,9 +179,7 @@ def _problem(
             f"and force > {min_force_N:g} N); a fit needs at least {MIN_CONTACT_SAMPLES}. "
             "Is this a palpation log with the probe pressed into the tissue?"
         )
-    return _Problem(
-        kin.eps_m, kin.eps_dot_m_per_s, kin.z_ddot_m_per_s2, data.force_N, mask
-    )
+    return p if mask is p.mask else replace(p, mask=mask)
 
 
 def _hc_columns(p: _Problem, beta: float, mask=None) -> np.ndarray:

@@ -32,6 +32,7 @@ from vic_drake.estimation.palpation.fits import (
     _check_mass,
     _hc_columns,
     _problem,
+    _restrict,
 )
 from vic_drake.estimation.signals import DEFAULT_DERIVATIVE_WINDOW_S
 from vic_drake.paper import BEST_BETA
@@ -227,13 +228,13 @@ def residual_vs_palpation_time(
         )
     combine = AVERAGES[average]
     central = np.median if average == "median" else np.mean
-    options = dict(
+    p = _problem(
+        data,
         derivative_window_s=derivative_window_s,
         min_penetration_m=DEFAULT_MIN_PENETRATION_M,
         min_force_N=DEFAULT_MIN_FORCE_N,
         spike_sigma=DEFAULT_SPIKE_SIGMA,
     )
-    p = _problem(data, **options)
     approach = None
     if skip_approach:
         approach = palpation_start(
@@ -245,7 +246,12 @@ def residual_vs_palpation_time(
         )
         if approach.cycles_skipped:
             t_start = data.t_s[np.argmax(p.mask)] + approach.start_s
-            p = _problem(data, sample_mask=data.t_s >= t_start - 1e-9, **options)
+            p = _restrict(
+                p,
+                data.t_s >= t_start - 1e-9,
+                min_penetration_m=DEFAULT_MIN_PENETRATION_M,
+                min_force_N=DEFAULT_MIN_FORCE_N,
+            )
     t_contact = data.t_s - data.t_s[np.argmax(p.mask)]
     total = float(t_contact[p.mask][-1])
     if windows_s is None:
