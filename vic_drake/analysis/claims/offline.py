@@ -147,14 +147,28 @@ def residual_decay(duration_s, residual) -> dict:
     }
 
 
+def _num(value) -> str:
+    return "n/a" if value is None else f"{value:.2f}"
+
+
+def c2_missed(d: Mapping) -> list[str]:
+    """C2's criteria that one residual curve's metrics miss, in words (a value
+    that is None, as in claims.json, or NaN misses its criterion)."""
+    r2, rho, ratio, a = (d.get(k) for k in ("r2", "spearman", "ratio_last_first", "a"))
+    missed = []
+    if r2 is None or not r2 >= C2_MIN_R2:
+        missed.append(f"R^2 {_num(r2)} (needs >= {C2_MIN_R2:g})")
+    if rho is None or not rho <= C2_MAX_SPEARMAN:
+        missed.append(f"Spearman {_num(rho)} (needs <= {C2_MAX_SPEARMAN:g})")
+    if ratio is None or not ratio <= C2_MAX_RATIO:
+        missed.append(f"last/first {_num(ratio)} (needs <= {C2_MAX_RATIO:g})")
+    if a is None or not a > 0:
+        missed.append("no falling amplitude")
+    return missed
+
+
 def _c2_pass(d: dict) -> bool:
-    return bool(
-        d["spearman"] <= C2_MAX_SPEARMAN
-        and np.isfinite(d["r2"])
-        and d["r2"] >= C2_MIN_R2
-        and d["a"] > 0
-        and d["ratio_last_first"] <= C2_MAX_RATIO
-    )
+    return not c2_missed(d)
 
 
 def c2_decay(curves) -> tuple:

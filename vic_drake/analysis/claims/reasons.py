@@ -11,32 +11,9 @@ and the claim's pass criterion.
 from collections.abc import Mapping
 
 from vic_drake.analysis.claims.claim import FAIL, claim_status
-from vic_drake.analysis.claims.thresholds import (
-    C2_MAX_RATIO,
-    C2_MAX_SPEARMAN,
-    C2_MIN_R2,
-)
+from vic_drake.analysis.claims.offline import c2_missed
 
 _SIDES = (("sim", "simulation"), ("real", "real logs"))
-
-
-def _num(value) -> str:
-    return "n/a" if value is None else f"{value:.2f}"
-
-
-def _c2_missed(d: Mapping) -> list[str]:
-    """C2's criteria that one residual curve misses (None = not finite)."""
-    r2, rho, ratio, a = (d.get(k) for k in ("r2", "spearman", "ratio_last_first", "a"))
-    missed = []
-    if r2 is None or not r2 >= C2_MIN_R2:
-        missed.append(f"R^2 {_num(r2)} (needs >= {C2_MIN_R2:g})")
-    if rho is None or not rho <= C2_MAX_SPEARMAN:
-        missed.append(f"Spearman {_num(rho)} (needs <= {C2_MAX_SPEARMAN:g})")
-    if ratio is None or not ratio <= C2_MAX_RATIO:
-        missed.append(f"last/first {_num(ratio)} (needs <= {C2_MAX_RATIO:g})")
-    if a is None or not a > 0:
-        missed.append("no falling amplitude")
-    return missed
 
 
 def c2_misses(value) -> list[str]:
@@ -49,12 +26,12 @@ def c2_misses(value) -> list[str]:
     if not isinstance(value, Mapping):
         return []
     if "ratio_last_first" in value:  # One curve.
-        missed = _c2_missed(value)
+        missed = c2_missed(value)
         return [f"misses {', '.join(missed)}"] if missed else []
     out = []
     for name, d in value.items():
         if isinstance(d, Mapping) and d.get("pass") is False:
-            missed = _c2_missed(d)
+            missed = c2_missed(d)
             out.append(f"{name} misses {', '.join(missed) or 'a criterion'}")
     return out
 
