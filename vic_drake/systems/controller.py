@@ -116,12 +116,7 @@ def MakeVariableImpedanceController(
                 "the estimator's surface_from_slope needs the reference's dither "
                 "(reference.penetration_dither_m > 0); got 0.0"
             )
-    # The slope fit's "direct" mode reads whether the QP's K_z is at its bound.
-    direct = (
-        online
-        and estimator.surface_from_slope
-        and estimator.slope_kappa_mode == "direct"
-    )
+    reads_stiffness = online and estimator.reads_stiffness
     builder = DiagramBuilder()
     ref = builder.AddNamedSystem(
         "force_reference",
@@ -140,7 +135,9 @@ def MakeVariableImpedanceController(
                 period_s=params.period_s,
                 surface_input=False,
                 surface_map=phantom if online_surface == "map" else None,
-                stiffness_max_z=params.qp.stiffness_max_N_per_m[2] if direct else None,
+                stiffness_max_z=params.qp.stiffness_max_N_per_m[2]
+                if reads_stiffness
+                else None,
             ),
         )
         builder.Connect(
@@ -148,7 +145,7 @@ def MakeVariableImpedanceController(
         )
         builder.ExportOutput(est.get_estimate_output_port(), "tissue_estimate")
     qp = builder.AddNamedSystem("stiffness_qp", StiffnessQpSystem(params))
-    if direct:  # (K from state: the last tick's, no algebraic loop)
+    if reads_stiffness:  # (K from state: the last tick's, no algebraic loop)
         builder.Connect(qp.get_stiffness_output_port(), est.get_stiffness_input_port())
     tank = builder.AddNamedSystem("energy_tank", EnergyTankSystem(params))
 

@@ -144,6 +144,12 @@ class OnlineEstimatorParams:
     def __post_init__(self):
         self.validate()
 
+    @property
+    def reads_stiffness(self) -> bool:
+        """Whether the estimator reads the controller's stiffness: the slope
+        fit's "direct" mode relaxes its held kappa while K_z is saturated."""
+        return self.surface_from_slope and self.slope_kappa_mode == "direct"
+
     def validate(self) -> "OnlineEstimatorParams":
         """Checks every field; returns self (raises VicDrakeError naming it)."""
         if self.method not in ONLINE_METHODS:

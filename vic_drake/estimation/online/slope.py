@@ -190,7 +190,8 @@ def _direct(
     p: OnlineEstimatorParams,
 ) -> None:
     """The "direct" mode's kappa and surface of one sample (in place)."""
-    if not math.isfinite(s[_KAPPA]) or force <= 0.0:
+    # (advance has returned already unless force > contact_threshold_N >= 0.)
+    if not math.isfinite(s[_KAPPA]):
         return
     held = s[_LN_KAPPA]
     valid = s[_VALID] == 1.0
