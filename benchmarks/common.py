@@ -71,12 +71,9 @@ def run_as_vic_drake() -> None:
     (:func:`checkout_environment`: the allocator ``vic-drake`` and the campaign
     workers run with), so an in-process figure is the one a scan process
     gives. At most once; ``VIC_DRAKE_ALLOCATOR=glibc`` measures glibc's."""
-    env = checkout_environment(HERE)
-    names = ("GLIBC_TUNABLES", "LD_PRELOAD")
-    if all(env.get(n) == os.environ.get(n) for n in names):
-        return
-    sys.stdout.flush()
-    os.execve(sys.executable, list(sys.orig_argv), env)
+    from vic_drake.malloc_tuning import restart_with
+
+    restart_with(checkout_environment(HERE))
 
 
 def run_in_checkout(tree: str, command: list[str]) -> subprocess.CompletedProcess:

@@ -35,7 +35,7 @@ from __future__ import annotations
 
 import os
 import sys
-from importlib import metadata
+from collections.abc import Mapping
 
 #: The environment variable glibc reads its tunables from.
 ENV_VAR = "GLIBC_TUNABLES"
@@ -68,17 +68,19 @@ def uses_glibc() -> bool:
 
 
 def mimalloc_library() -> str | None:
-    """The path of the installed mimalloc shared library, or None (not installed)."""
-    try:
-        dist = metadata.distribution(MIMALLOC_DISTRIBUTION)
-    except metadata.PackageNotFoundError:
-        return None
-    path = os.path.abspath(str(dist.locate_file(MIMALLOC_LIBRARY)))
-    # LD_PRELOAD separates its entries with spaces and colons: such a path
-    # cannot be named there.
-    if not os.path.isfile(path) or any(c in path for c in " \t:"):
-        return None
-    return path
+    """The path of the installed mimalloc shared library, or None (not installed).
+
+    Looked for as :data:`MIMALLOC_LIBRARY` under the entries of ``sys.path``,
+    where pip puts the wheel's files (no ``importlib.metadata``: this runs
+    before every command restarts, and that import alone costs ~25 ms).
+    """
+    for entry in sys.path:
+        path = os.path.abspath(os.path.join(entry or ".", MIMALLOC_LIBRARY))
+        if os.path.isfile(path):
+            # LD_PRELOAD separates its entries with spaces and colons: such
+            # a path cannot be named there.
+            return None if any(c in path for c in " \t:") else path
+    return None
 
 
 def allocator(environ=None) -> str:
@@ -141,20 +143,28 @@ def tuned_environment(environ=None) -> dict[str, str]:
     return env
 
 
-def reexec_tuned() -> None:
-    """Restarts this program (same interpreter and arguments) with the tuned environment.
+def restart_with(env: Mapping[str, str]) -> None:
+    """Restarts this program (same interpreter and arguments) with ``env``
+    unless its allocator settings are already this process's (so it restarts
+    at most once). Call it before any output."""
+    if all(env.get(n) == os.environ.get(n) for n in (ENV_VAR, PRELOAD_VAR)):
+        return
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os.execve(sys.executable, list(sys.orig_argv), dict(env))
 
-    Does nothing when the environment is already tuned (so it restarts at
-    most once) or the C library is not glibc. Call it before any output.
+
+def reexec_tuned() -> None:
+    """Restarts this program with the tuned environment (:func:`restart_with`).
+
+    Does nothing when the environment is already tuned or the C library is
+    not glibc.
 
     Raises:
         ValueError: :data:`ALLOCATOR_VAR` names an unknown allocator.
     """
-    if not uses_glibc() or is_tuned():
-        return
-    sys.stdout.flush()
-    sys.stderr.flush()
-    os.execve(sys.executable, list(sys.orig_argv), tuned_environment())
+    if uses_glibc():
+        restart_with(tuned_environment())
 
 
 __all__ = [
@@ -168,6 +178,7 @@ __all__ = [
     "is_tuned",
     "mimalloc_library",
     "reexec_tuned",
+    "restart_with",
     "tuned_environment",
     "tuned_preload",
     "tuned_tunables",
