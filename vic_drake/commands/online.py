@@ -19,6 +19,7 @@ from vic_drake.commands.common import (
     add_json_option,
     bag_path,
     emit,
+    help_text,
 )
 from vic_drake.errors import VicDrakeError
 
@@ -101,7 +102,7 @@ def register(subparsers) -> None:
     p = subparsers.add_parser(
         "estimate-online",
         help="replay an online kappa/lambda estimator over a real log",
-        description=__doc__.split("\n\n")[1],
+        description=help_text(__doc__, 1),
     )
     p.add_argument(
         "bag_dir",

@@ -143,10 +143,12 @@ def scan_metrics_dict(scenario, result, path: Path, force_limit_N=None) -> dict:
         "duration_s": result.sim_s,
         "rtf": result.rtf,
         # CS has no force reference: its RMSE against one is undefined.
-        "force_rmse_N": None if controller == "cs" else scan_metrics.force_rmse_N(df),
-        "force_range_N": list(scan_metrics.force_range_N(df)),
+        "force_rmse_N": None
+        if controller == "cs"
+        else scan_metrics.force_rmse_N(df, mask=window),
+        "force_range_N": list(scan_metrics.force_range_N(df, mask=window)),
         "force_peak_N": scan_metrics.peak_force_N(df),
-        "tank_min_J": scan_metrics.tank_min_J(df, has_tank=tank),
+        "tank_min_J": campaign["tank_min_J"],
         "contact_loss_s": [list(i) for i in contact.contact_loss_intervals(df)],
         "lifted_off": scan_metrics.lifted_off(df),
         "scan_window_s": [float(t[window][0]), float(t[window][-1])]

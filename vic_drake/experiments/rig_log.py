@@ -88,21 +88,20 @@ def rig_log_ports(controller) -> dict:
     return ports
 
 
-def rig_frame(logs, root_context, n_rows: int) -> pd.DataFrame:
-    """The :data:`RIG_SIGNALS` of a scan's logs, first n_rows samples.
+def rig_frame(logs, root_context) -> pd.DataFrame:
+    """The :data:`RIG_SIGNALS` of a scan's logs (one sink: every sample of the scan).
 
     Args:
         logs: the scan's :class:`~vic_drake.experiments.scan_logs.ScanLogs`
             (holding :data:`RIG_GROUPS`, whose ports :func:`rig_log_ports` gives).
         root_context: the scan diagram's root context after the simulation.
-        n_rows: the number of samples kept.
     """
     data = {}
     for group in RIG_GROUPS:
         values = logs.rows(group.name, root_context)
         for i, column in enumerate(group.columns):
             if column is not None:
-                data[column] = values[i, :n_rows]
+                data[column] = values[i]
     return pd.DataFrame(data)[list(RIG_SIGNALS)]
 
 

@@ -120,7 +120,7 @@ def run_scan(
     cpu = time.process_time() - c0
     df = logs_to_frame(logs, context)
     df.attrs.update(source="sim", scenario=scenario.name)
-    rig = rig_frame(logs, context, len(df))
+    rig = rig_frame(logs, context)
     rig.attrs["beta"] = float(phantom.beta)
     return ScanResult(
         df=df,
