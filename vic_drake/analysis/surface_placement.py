@@ -36,7 +36,6 @@ from vic_drake.analysis.columns import require_columns
 from vic_drake.analysis.contact import pressing_force_N, scan_window
 from vic_drake.analysis.phantom_motion import penetration_m
 from vic_drake.errors import VicDrakeError
-from vic_drake.paper import CONTACT_THRESHOLD_N
 from vic_drake.tissue.relaxation import DEFAULT_RELAXATION, relaxation_history
 
 #: Bin length along the track, m.
@@ -198,7 +197,8 @@ def fit_surface_placement(
             f"{window.shape}"
         )
     surface = apparent_surface_m(df, phantom, relaxation=relaxation)
-    use = window & np.isfinite(surface) & (pressing_force_N(df) > CONTACT_THRESHOLD_N)
+    # (A finite surface is in contact: penetration_m is NaN at or below the threshold.)
+    use = window & np.isfinite(surface)
     if use.sum() < MIN_BINS * MIN_BIN_SAMPLES:
         return None
     xy = np.c_[df["x_m"].to_numpy(float)[use], df["y_m"].to_numpy(float)[use]]
