@@ -52,7 +52,7 @@ from vic_drake.experiments.campaign.plan import RunPlan, plan_campaign
 from vic_drake.experiments.campaign.run import failed_row
 from vic_drake.experiments.campaign.spec import CampaignSpec, load_campaign_spec
 from vic_drake.experiments.campaign.stats import per_controller
-from vic_drake.malloc_tuning import tuned_environment
+from vic_drake.malloc_tuning import allocator
 from vic_drake.paths import check_output_dir
 from vic_drake.scenario import dumps_scenario, load_scenario
 
@@ -190,7 +190,7 @@ def _client(workers: int | None, scheduler: str | None):
     # The runs' own processes get the scans' allocator (execute_run_in_child);
     # the workers only dispatch. A bad VIC_DRAKE_ALLOCATOR fails here, first.
     try:
-        tuned_environment(os.environ)
+        allocator(os.environ)
     except ValueError as exc:
         raise VicDrakeError(str(exc)) from None
     from vic_drake.experiments.campaign.workers import IgnoreCtrlC
