@@ -105,6 +105,16 @@ def _close_names(folder: Path, name: str) -> list[str]:
     return difflib.get_close_matches(name, names, n=3, cutoff=0.6)
 
 
+def _did_you_mean(folder: Path, name: str, shown: Path | None = None) -> str:
+    """ " (did you mean ...?)" naming :func:`_close_names`, each as ``shown /
+    name`` (the bare name without ``shown``); "" when none is close."""
+    near = _close_names(folder, name)
+    if not near:
+        return ""
+    items = (repr(n) if shown is None else repr(str(shown / n)) for n in near)
+    return f" (did you mean {', '.join(items)}?)"
+
+
 def find_bag(
     text: str | os.PathLike,
     data_dir: str | os.PathLike | None = None,
@@ -128,8 +138,7 @@ def find_bag(
     if path.exists():
         return path
     if path.is_absolute():
-        near = _close_names(path.parent, path.name)
-        hint = f" (did you mean {', '.join(repr(n) for n in near)}?)" if near else ""
+        hint = _did_you_mean(path.parent, path.name)
         raise DataNotFoundError(
             f"{what} {str(text)!r} does not exist{hint}; expected {expected}"
         )
@@ -141,14 +150,7 @@ def find_bag(
     here = f"in the current folder ({str(Path.cwd())!r})"
     if folder.is_dir():
         there = f"nor in the data folder {str(folder)!r} ({source})"
-        near = _close_names(candidate.parent, candidate.name)
-        if near:
-            parent = path.parent
-            there += (
-                " (did you mean "
-                + ", ".join(repr(str(parent / n)) for n in near)
-                + "?)"
-            )
+        there += _did_you_mean(candidate.parent, candidate.name, path.parent)
     else:
         there = (
             f"and there is no data folder ({source}: {str(folder)!r} does not "
@@ -207,14 +209,7 @@ def check_input_file(
             f"{what} {str(path)!r} is a folder (with no {suffixes[0]} files in it); "
             f"give a {suffixes[0]} file"
         )
-    near = _close_names(p.parent, p.name) if p.parent.is_dir() else []
-    hint = (
-        " (did you mean "
-        + ", ".join(repr(str(Path(path).parent / n)) for n in near)
-        + "?)"
-        if near
-        else ""
-    )
+    hint = _did_you_mean(p.parent, p.name, Path(path).parent)
     raise VicDrakeError(f"{what} {str(path)!r} does not exist{hint}")
 
 
