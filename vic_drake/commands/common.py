@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 
 from vic_drake.errors import VicDrakeError
@@ -61,6 +62,13 @@ def help_text(doc: str, paragraph: int | None = None) -> str:
     if paragraph is not None:
         doc = doc.split("\n\n")[paragraph]
     return doc.replace("``", "")
+
+
+def fmt_number(value, spec: str = ".3f") -> str:
+    """``value`` formatted with ``spec``, or "n/a" for None and non-finite values."""
+    if value is None or not math.isfinite(float(value)):
+        return "n/a"
+    return format(value, spec)
 
 
 def add_json_option(parser: argparse.ArgumentParser) -> None:

@@ -19,6 +19,7 @@ from vic_drake.commands.common import (
     add_json_option,
     bag_path,
     emit,
+    fmt_number,
     help_text,
 )
 from vic_drake.errors import VicDrakeError
@@ -63,18 +64,15 @@ def _estimate_online(args: argparse.Namespace) -> int:
         else "measured GP map at the probe's (x, y)"
     )
 
-    def fmt(v, spec):
-        return "n/a" if v is None or not math.isfinite(v) else format(v, spec)
-
     human = "\n".join(
         [
             f"{result.kind} {args.bag_dir}: {s['samples']} samples, method {s['method']}, "
             f"force paired with the position {result.lag_s * 1e3:.1f} ms earlier",
             f"reference: {ref}",
-            f"kappa: median relative error {fmt(s['kappa_rel_err_median'], '.3f')}, "
-            f"correlation {fmt(s['kappa_corr'], '.3f')}, at the last contact sample "
-            f"{fmt(result.final_kappa_rel_err, '.3f')}",
-            f"lambda: median relative error {fmt(s['lambda_rel_err_median'], '.3f')}",
+            f"kappa: median relative error {fmt_number(s['kappa_rel_err_median'], '.3f')}, "
+            f"correlation {fmt_number(s['kappa_corr'], '.3f')}, at the last contact sample "
+            f"{fmt_number(result.final_kappa_rel_err, '.3f')}",
+            f"lambda: median relative error {fmt_number(s['lambda_rel_err_median'], '.3f')}",
             _convergence_line(s["convergence_s"]),
             f"tick cost p99 {s['tick_us_p99']:.1f} us (as a function)",
         ]

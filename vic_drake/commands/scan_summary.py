@@ -16,6 +16,7 @@ import difflib
 import math
 from pathlib import Path
 
+from vic_drake.commands.common import fmt_number
 from vic_drake.errors import VicDrakeError
 from vic_drake.paths import DIAGRAMS_DIR
 
@@ -158,14 +159,6 @@ def scan_metrics_dict(scenario, result, path: Path, force_limit_N=None) -> dict:
     }
 
 
-def _n(value, spec: str = ".3f") -> str:
-    return (
-        "n/a"
-        if value is None or not math.isfinite(float(value))
-        else format(value, spec)
-    )
-
-
 def scan_human_summary(out: dict, scenario) -> str:
     """The scan's result in words (what prints without --json)."""
     c = out["campaign_metrics"]
@@ -175,10 +168,10 @@ def scan_human_summary(out: dict, scenario) -> str:
         f"{out['scenario']} ({out['controller']}): {out['duration_s']:.2f} s "
         f"simulated, RTF {out['rtf']:.2f}",
         f"force on the patient (tissue force; the campaign's peak_force_N): peak "
-        f"{_n(c['peak_force_N'])} N, p99 {_n(c['p99_force_N'])} N, "
-        f"{_n(c['time_above_limit_s'], '.2f')} s above {c['force_limit_N']:g} N "
+        f"{fmt_number(c['peak_force_N'])} N, p99 {fmt_number(c['p99_force_N'])} N, "
+        f"{fmt_number(c['time_above_limit_s'], '.2f')} s above {c['force_limit_N']:g} N "
         f"({c['force_limit_source']})",
-        f"sensor force (with its noise; force_peak_N): peak {_n(out['force_peak_N'])} N",
+        f"sensor force (with its noise; force_peak_N): peak {fmt_number(out['force_peak_N'])} N",
     ]
     if window is None:
         lines.append(
@@ -196,11 +189,11 @@ def scan_human_summary(out: dict, scenario) -> str:
         rmse = (
             "no force reference (CS)"
             if out["controller"] == "cs"
-            else f"RMSE against the reference {_n(out['force_rmse_N'])} N"
+            else f"RMSE against the reference {fmt_number(out['force_rmse_N'])} N"
         )
         lines.append(
             f"scan window {window[0]:.2f}-{window[1]:.2f} s: sensor force "
-            f"{_n(lo, '.2f')}-{_n(hi, '.2f')} N, {rmse}"
+            f"{fmt_number(lo, '.2f')}-{fmt_number(hi, '.2f')} N, {rmse}"
         )
     losses = out["contact_loss_s"]
     if losses:
@@ -212,7 +205,7 @@ def scan_human_summary(out: dict, scenario) -> str:
     else:
         lines.append("contact losses: none")
     tank = (
-        f"tank minimum {_n(out['tank_min_J'])} J (floor {c['tank_floor_J']:g} J)"
+        f"tank minimum {fmt_number(out['tank_min_J'])} J (floor {c['tank_floor_J']:g} J)"
         if math.isfinite(c["tank_floor_J"])
         else "no energy tank (" + out["controller"] + ")"
     )
