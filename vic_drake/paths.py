@@ -22,6 +22,11 @@ DEFAULT_DATA_DIR = PROJECT_ROOT.parent / "shared" / "data"
 DIAGRAMS_DIR = PROJECT_ROOT / "diagrams"
 
 
+def diagram_names() -> list[str]:
+    """The shipped scenarios: the stems of ``diagrams/*.yaml``, sorted."""
+    return sorted(p.stem for p in DIAGRAMS_DIR.glob("*.yaml"))
+
+
 def resolve_data_dir(data_dir: str | os.PathLike | None = None) -> Path:
     """Returns the data folder to use (it may not exist; see require_data_dir)."""
     if data_dir is not None:

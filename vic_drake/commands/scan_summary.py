@@ -18,7 +18,7 @@ from pathlib import Path
 
 from vic_drake.commands.common import fmt_number
 from vic_drake.errors import VicDrakeError
-from vic_drake.paths import DIAGRAMS_DIR
+from vic_drake.paths import DIAGRAMS_DIR, diagram_names
 
 SCAN_DESCRIPTION = (
     "Simulates one scenario file (the station, phantom, controller, trajectory "
@@ -56,8 +56,7 @@ def scenario_path(text: str, say=None) -> Path:
         if say is not None:
             say(f"scenario {text!r}: the shipped {shipped}")
         return shipped
-    names = sorted(p.stem for p in DIAGRAMS_DIR.glob("*.yaml"))
-    near = difflib.get_close_matches(stem, names, n=3, cutoff=0.6)
+    near = difflib.get_close_matches(stem, diagram_names(), n=3, cutoff=0.6)
     hint = (
         "; did you mean " + ", ".join(f"diagrams/{n}.yaml" for n in near) + "?"
         if near

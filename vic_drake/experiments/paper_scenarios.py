@@ -26,7 +26,7 @@ from vic_drake.experiments.real_logs import (
     with_z_gains,
 )
 from vic_drake.paper import CONTROLLERS, DISTURBANCE_CONTROLLERS
-from vic_drake.paths import DIAGRAMS_DIR, require_data_dir
+from vic_drake.paths import DIAGRAMS_DIR, diagram_names, require_data_dir
 from vic_drake.realdata import read_bag
 from vic_drake.scenario import (
     DisturbanceConfig,
@@ -195,7 +195,7 @@ def load_diagram(name: str) -> Scenario:
     """
     path = DIAGRAMS_DIR / f"{name}.yaml"
     if not path.is_file():
-        known = sorted(p.stem for p in DIAGRAMS_DIR.glob("*.yaml"))
+        known = diagram_names()
         raise VicDrakeError(
             f"no scenario file {str(path)!r}; diagrams/ holds {known or 'nothing'}"
         )
