@@ -211,14 +211,13 @@ def identify_real_log(
             "a 9-column log is a CS or CF scan; --controller must be cs or cf, "
             f"got {controller!r}"
         )
-    if controller is not None:
-        check_settings_apply(controller, True, stiffness_N_per_m, force_N, r_weight)
     if controller is None:
         found = identify_controller(real, r_weight=r_weight)
         check_settings_apply(
             found.controller, False, stiffness_N_per_m, force_N, r_weight
         )
         return found
+    check_settings_apply(controller, True, stiffness_N_per_m, force_N, r_weight)
     setting = {"cs": stiffness_N_per_m, "cf": force_N}.get(controller)
     if layout == "scan" and setting is not None:
         return ControllerIdentification(controller, given=True)
