@@ -249,6 +249,9 @@ def compare_real(
     plane = surface["plane"]
     if plane is not None:
         phantom = with_surface_plane(published, **plane)
+    # The simulated tissue is a reshaped map (profile or plane): the controller
+    # reads the published one, as the real controller read its own.
+    own_surface = profile is not None or plane is not None
     lateral_passes = resolve_lateral_passes(lateral_passes, replayed=replay)
     disturbance = DisturbanceConfig(table=table) if replay else None
     lift_m = motion["phantom_lift_m"].to_numpy()
@@ -282,16 +285,14 @@ def compare_real(
         scenario.station.tissue_law = tissue_law
     if relaxation is not None:
         scenario.station = scenario.station.with_relaxation(relaxation)
-    if surface["offset_m"] != 0.0 and profile is None and plane is None:
+    if surface["offset_m"] != 0.0 and not own_surface:
         # The controller reads the published map, as the real one read its own.
         scenario.variations.map_errors.surface_offset_m = -surface["offset_m"]
     if tissue_law is not None or relaxation is not None or surface["offset_m"] != 0.0:
         scenario.validate()
     if progress:
         progress(scenario.description)
-    extra = (
-        {} if profile is None and plane is None else {"controller_phantom": published}
-    )
+    extra = {"controller_phantom": published} if own_surface else {}
     result = run_scan(
         scenario, phantom=phantom, duration_s=duration_s, progress=progress, **extra
     )
