@@ -20,6 +20,9 @@ PROJECT_ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_DATA_DIR = PROJECT_ROOT.parent / "shared" / "data"
 #: The scenario files of the paper's runs (the source of truth of reproduce).
 DIAGRAMS_DIR = PROJECT_ROOT / "diagrams"
+#: The marker file of a ``vic-drake reproduce`` run's folder (written by
+#: vic_drake.reproduce.run_dir; a campaign refuses such a folder by it).
+REPRODUCE_RUN_FILE = "run.json"
 
 
 def diagram_names() -> list[str]:

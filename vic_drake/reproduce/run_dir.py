@@ -28,10 +28,10 @@ import time
 from pathlib import Path
 
 from vic_drake.errors import VicDrakeError
-from vic_drake.paths import check_output_dir
+from vic_drake.paths import REPRODUCE_RUN_FILE, check_output_dir
 
 #: The marker file of a run folder.
-RUN_FILE = "run.json"
+RUN_FILE = REPRODUCE_RUN_FILE
 
 
 def work_dir_for(out_dir: Path) -> Path:

@@ -53,7 +53,7 @@ from vic_drake.experiments.campaign.run import failed_row
 from vic_drake.experiments.campaign.spec import CampaignSpec, load_campaign_spec
 from vic_drake.experiments.campaign.stats import per_controller
 from vic_drake.malloc_tuning import allocator
-from vic_drake.paths import check_output_dir
+from vic_drake.paths import REPRODUCE_RUN_FILE, check_output_dir
 from vic_drake.scenario import dumps_scenario, load_scenario
 
 
@@ -77,10 +77,6 @@ def read_rows(out: Path) -> pd.DataFrame:
     ]
     df = pd.DataFrame(rows)
     return df.sort_values("index").reset_index(drop=True) if not df.empty else df
-
-
-#: The marker of a vic-drake reproduce run's folder (vic_drake.reproduce.run_dir).
-REPRODUCE_MARKER = "run.json"
 
 
 def _check_out(
@@ -130,8 +126,8 @@ def _check_out(
 
 def _contents(out: Path) -> str:
     """What a folder that is not a campaign holds, for the refusal."""
-    if (out / REPRODUCE_MARKER).is_file():
-        return f"a vic-drake reproduce run ({REPRODUCE_MARKER})"
+    if (out / REPRODUCE_RUN_FILE).is_file():
+        return f"a vic-drake reproduce run ({REPRODUCE_RUN_FILE})"
     names = sorted(p.name + ("/" if p.is_dir() else "") for p in out.iterdir())
     shown = ", ".join(names[:4]) + (", ..." if len(names) > 4 else "")
     return f"other files ({shown}; no spec.yaml)"
