@@ -15,10 +15,6 @@ BAG_COMMANDS = {
     "compare-real": ["{bag}"],
 }
 
-#: The commands of this repository's command-line helpers (reproduce and
-#: campaign have their own tests).
-OWN_COMMANDS = (*BAG_COMMANDS, "map", "scan")
-
 
 def fake_data_dir(root):
     """A folder check_data_dir accepts, holding one bag folder without its
@@ -126,7 +122,11 @@ def test_an_extra_positional_shows_the_subcommands_usage(capsys):
     assert err.rstrip().endswith("unrecognized arguments: b")
 
 
-@pytest.mark.parametrize("command", OWN_COMMANDS)
+#: Every subcommand the parser has.
+ALL_COMMANDS = tuple(build_parser().get_default("_subparsers").choices)
+
+
+@pytest.mark.parametrize("command", ALL_COMMANDS)
 def test_help_has_no_rest_markup(command):
     text = subcommand_parser(build_parser(), command).format_help()
     assert "``" not in text

@@ -14,7 +14,7 @@ from __future__ import annotations
 import argparse
 import math
 
-from vic_drake.commands.common import Progress, add_json_option, emit
+from vic_drake.commands.common import Progress, add_json_option, emit, help_text
 from vic_drake.errors import VicDrakeError
 
 #: The keys --json prints (the command's contract), in order.
@@ -58,7 +58,7 @@ def register(subparsers) -> None:
     p = subparsers.add_parser(
         "campaign",
         help="run a safety campaign (many scans with sampled variations) on Dask",
-        description=__doc__.split("\n\n", 1)[1],
+        description=help_text(__doc__, 1),
     )
     p.add_argument(
         "spec", metavar="SPEC.yaml", help="the campaign spec (campaigns/*.yaml)"
