@@ -23,6 +23,11 @@ DIAGRAMS_DIR = PROJECT_ROOT / "diagrams"
 #: The marker file of a ``vic-drake reproduce`` run's folder (written by
 #: vic_drake.reproduce.run_dir; a campaign refuses such a folder by it).
 REPRODUCE_RUN_FILE = "run.json"
+#: A campaign folder's spec and its folder of run scenarios (written by
+#: vic_drake.experiments.campaign.engine; scan reads a run's force limit
+#: from the spec beside its scenario).
+CAMPAIGN_SPEC_FILE = "spec.yaml"
+CAMPAIGN_SCENARIOS_DIR = "scenarios"
 
 
 def diagram_names() -> list[str]:

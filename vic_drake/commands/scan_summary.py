@@ -18,7 +18,12 @@ from pathlib import Path
 
 from vic_drake.commands.common import fmt_number
 from vic_drake.errors import VicDrakeError
-from vic_drake.paths import DIAGRAMS_DIR, diagram_names
+from vic_drake.paths import (
+    CAMPAIGN_SCENARIOS_DIR,
+    CAMPAIGN_SPEC_FILE,
+    DIAGRAMS_DIR,
+    diagram_names,
+)
 
 SCAN_DESCRIPTION = (
     "Simulates one scenario file (the station, phantom, controller, trajectory "
@@ -96,8 +101,8 @@ def campaign_force_limit(path: Path) -> tuple[float, str]:
     # every vic-drake command builds this module's parser.
     from vic_drake.experiments.campaign.spec import CampaignSpec
 
-    spec = path.resolve().parent.parent / "spec.yaml"
-    if path.resolve().parent.name == "scenarios" and spec.is_file():
+    spec = path.resolve().parent.parent / CAMPAIGN_SPEC_FILE
+    if path.resolve().parent.name == CAMPAIGN_SCENARIOS_DIR and spec.is_file():
         import yaml
 
         try:

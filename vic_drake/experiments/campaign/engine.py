@@ -53,7 +53,12 @@ from vic_drake.experiments.campaign.run import failed_row
 from vic_drake.experiments.campaign.spec import CampaignSpec, load_campaign_spec
 from vic_drake.experiments.campaign.stats import per_controller
 from vic_drake.malloc_tuning import allocator
-from vic_drake.paths import REPRODUCE_RUN_FILE, check_output_dir
+from vic_drake.paths import (
+    CAMPAIGN_SCENARIOS_DIR,
+    CAMPAIGN_SPEC_FILE,
+    REPRODUCE_RUN_FILE,
+    check_output_dir,
+)
 from vic_drake.scenario import dumps_scenario, load_scenario
 
 
@@ -91,7 +96,7 @@ def _check_out(
     """
     if out.exists() and not out.is_dir():
         raise VicDrakeError(f"--out {str(out)!r} is a file; give a folder")
-    stored = out / "spec.yaml"
+    stored = out / CAMPAIGN_SPEC_FILE
     if stored.is_file():
         if not resume:
             raise VicDrakeError(
@@ -130,14 +135,14 @@ def _contents(out: Path) -> str:
         return f"a vic-drake reproduce run ({REPRODUCE_RUN_FILE})"
     names = sorted(p.name + ("/" if p.is_dir() else "") for p in out.iterdir())
     shown = ", ".join(names[:4]) + (", ..." if len(names) > 4 else "")
-    return f"other files ({shown}; no spec.yaml)"
+    return f"other files ({shown}; no {CAMPAIGN_SPEC_FILE})"
 
 
 def _create(out: Path, spec_text: str) -> None:
     """Makes the campaign's folder and writes its spec (once the runs can start)."""
-    (out / "scenarios").mkdir(parents=True, exist_ok=True)
+    (out / CAMPAIGN_SCENARIOS_DIR).mkdir(parents=True, exist_ok=True)
     (out / "rows").mkdir(exist_ok=True)
-    _atomic_write(out / "spec.yaml", spec_text)
+    _atomic_write(out / CAMPAIGN_SPEC_FILE, spec_text)
 
 
 def _record(out: Path, plan: RunPlan, row: dict) -> None:
@@ -145,7 +150,7 @@ def _record(out: Path, plan: RunPlan, row: dict) -> None:
     text = row.pop("_scenario_yaml", None)
     if text is None:  # The worker never got to build it (e.g. it died).
         text = dumps_scenario(plan.scenario())
-    _atomic_write(out / "scenarios" / f"{plan.run_id}.yaml", text)
+    _atomic_write(out / CAMPAIGN_SCENARIOS_DIR / f"{plan.run_id}.yaml", text)
     _atomic_write(out / "rows" / f"{plan.run_id}.json", json.dumps(row))
 
 
