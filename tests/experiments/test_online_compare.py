@@ -23,14 +23,16 @@ from vic_drake.tissue.phantom import GridPhantom
 
 def test_dithered_runs_set_the_dither_and_only_online_reads_the_slope():
     base = Scenario()
-    for run, (source, *_, dither) in COMPARISON_RUNS.items():
+    for run, spec in COMPARISON_RUNS.items():
         s = comparison_scenario(base, run)
         ref = s.controller.reference
-        assert ref.penetration_dither_m == (DITHER_M if dither else 0.0)
-        assert s.online_estimator.surface_from_slope == (dither and source == "online")
-        mode = "direct" if dither and source == "online" else "tracker"
+        online_dither = spec.dither and spec.source == "online"
+        assert ref.penetration_dither_m == (DITHER_M if spec.dither else 0.0)
+        assert s.online_estimator.surface_from_slope == online_dither
+        mode = "direct" if run == "online_dither" else "tracker"
         assert s.online_estimator.slope_kappa_mode == mode
     assert "online_dither" not in UNDITHERED_RUNS and "online" in UNDITHERED_RUNS
+    assert "online_dither_tracker" not in UNDITHERED_RUNS
 
 
 SYNTHETIC = (
@@ -41,11 +43,11 @@ SYNTHETIC = (
 def test_dither_frequency_reaches_the_dithered_runs_only():
     base = Scenario()
     unset = base.controller.reference.penetration_dither_hz
-    for run, (*_, dither) in COMPARISON_RUNS.items():
+    for run, spec in COMPARISON_RUNS.items():
         default = comparison_scenario(base, run).controller.reference
         other = comparison_scenario(base, run, dither_hz=2.9).controller.reference
-        assert default.penetration_dither_hz == (DITHER_HZ if dither else unset)
-        assert other.penetration_dither_hz == (2.9 if dither else unset)
+        assert default.penetration_dither_hz == (DITHER_HZ if spec.dither else unset)
+        assert other.penetration_dither_hz == (2.9 if spec.dither else unset)
         assert other.penetration_dither_m == default.penetration_dither_m
 
 
@@ -64,6 +66,21 @@ def test_bad_dither_frequency_is_refused_before_any_scan(value, message, capsys)
     assert exc.value.code == 2
     err = capsys.readouterr().err
     assert "--dither-hz" in err and message in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize(
+    "value, message",
+    [
+        ("3", "force_min_z_N must be < 0 (sensor convention, pressing); got 3.0"),
+        ("nan", "force_min_z_N must be finite"),
+    ],
+)
+def test_bad_force_bound_is_refused_before_any_scan(value, message, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main([str(SYNTHETIC), "true_map", f"--force-min-z={value}"])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert "--force-min-z" in err and message in err and "Traceback" not in err
 
 
 def test_true_references_with_and_without_the_dither():

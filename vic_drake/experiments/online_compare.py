@@ -17,8 +17,14 @@ well):
   surface from the tissue's slope under the dithered tip
   (``online_estimator.surface_from_slope``, no EKF surface state) in the
   fit's "direct" mode (``slope_kappa_mode``: kappa from the fit, held,
-  relaxed towards the force while K_z is saturated). The map runs with the
-  dither show what the dither alone costs.
+  relaxed towards the force while K_z is saturated);
+  "online_dither_tracker" is the same in the fit's "tracker" mode (the
+  estimator's default: the fit's surface through a slow filter). The map
+  runs with the dither show what the dither alone costs.
+
+``main``'s ``--force-min-z`` sets VS-VF's F_min,z of every run (the rig's
+-9 N binds on the ribs in every run, so their p99 force there is the
+bound's; docs/decisions.md, "The closed loop at the QP's own force bound").
 
 Scores over the scan window (:func:`vic_drake.analysis.contact.scan_window`):
 
@@ -45,6 +51,7 @@ Scores over the scan window (:func:`vic_drake.analysis.contact.scan_window`):
 from __future__ import annotations
 
 import copy
+from typing import NamedTuple
 
 import numpy as np
 
@@ -59,25 +66,40 @@ from vic_drake.scenario import Scenario
 DITHER_M = 3e-4
 DITHER_HZ = 3.0
 
-#: The runs of the comparison: name -> (stiffness_source, kappa_scale,
-#: surface_offset_m, online_surface, dither). "online" reads no map at all;
+
+class ComparisonRun(NamedTuple):
+    """One run of the comparison: the stiffness source ("map" | "online"),
+    the map's error (kappa scale, surface offset, m), the online estimator's
+    surface ("estimated" | "map"), whether the dither is on and, for the
+    dithered online runs, the slope fit's ``slope_kappa_mode``."""
+
+    source: str
+    kappa_scale: float
+    surface_offset_m: float
+    online_surface: str
+    dither: bool
+    slope_kappa_mode: str = "tracker"
+
+
+#: The runs of the comparison. "online" reads no map at all;
 #: "online_map_surface" takes only the surface from the true map and
 #: "online_wrong_surface" from the map 2 mm too high (kappa, lam online).
 COMPARISON_RUNS = {
-    "true_map": ("map", 1.0, 0.0, "estimated", False),
-    "wrong_map_+30": ("map", 1.3, 0.002, "estimated", False),
-    "wrong_map_-30": ("map", 0.7, 0.002, "estimated", False),
-    "online": ("online", 1.0, 0.0, "estimated", False),
-    "online_map_surface": ("online", 1.0, 0.0, "map", False),
-    "online_wrong_surface": ("online", 1.0, 0.002, "map", False),
-    "true_map_dither": ("map", 1.0, 0.0, "estimated", True),
-    "wrong_map_+30_dither": ("map", 1.3, 0.002, "estimated", True),
-    "wrong_map_-30_dither": ("map", 0.7, 0.002, "estimated", True),
-    "online_dither": ("online", 1.0, 0.0, "estimated", True),
+    "true_map": ComparisonRun("map", 1.0, 0.0, "estimated", False),
+    "wrong_map_+30": ComparisonRun("map", 1.3, 0.002, "estimated", False),
+    "wrong_map_-30": ComparisonRun("map", 0.7, 0.002, "estimated", False),
+    "online": ComparisonRun("online", 1.0, 0.0, "estimated", False),
+    "online_map_surface": ComparisonRun("online", 1.0, 0.0, "map", False),
+    "online_wrong_surface": ComparisonRun("online", 1.0, 0.002, "map", False),
+    "true_map_dither": ComparisonRun("map", 1.0, 0.0, "estimated", True),
+    "wrong_map_+30_dither": ComparisonRun("map", 1.3, 0.002, "estimated", True),
+    "wrong_map_-30_dither": ComparisonRun("map", 0.7, 0.002, "estimated", True),
+    "online_dither": ComparisonRun("online", 1.0, 0.0, "estimated", True, "direct"),
+    "online_dither_tracker": ComparisonRun("online", 1.0, 0.0, "estimated", True),
 }
 
 #: The runs of the comparison before the dither (issue 12's first table).
-UNDITHERED_RUNS = tuple(name for name, run in COMPARISON_RUNS.items() if not run[4])
+UNDITHERED_RUNS = tuple(name for name, run in COMPARISON_RUNS.items() if not run.dither)
 
 
 def comparison_scenario(
@@ -89,22 +111,22 @@ def comparison_scenario(
     VicDrakeError from the scenario's validation if the controller cannot
     take it).
     """
-    source, kappa_scale, offset, surface, dither = COMPARISON_RUNS[run]
+    spec = COMPARISON_RUNS[run]
     s = copy.deepcopy(base)
     s.name = f"{base.name}_{run}"
-    s.stiffness_source = source
-    s.online_surface = surface
-    if surface == "map":  # Trust the map's surface: no surface state.
+    s.stiffness_source = spec.source
+    s.online_surface = spec.online_surface
+    if spec.online_surface == "map":  # Trust the map's surface: no surface state.
         s.online_estimator.surface_walk_m_per_sqrt_s = 0.0
-    s.variations.map_errors.kappa_scale = kappa_scale
-    s.variations.map_errors.surface_offset_m = offset
-    if dither:
+    s.variations.map_errors.kappa_scale = spec.kappa_scale
+    s.variations.map_errors.surface_offset_m = spec.surface_offset_m
+    if spec.dither:
         s.controller.reference.penetration_dither_m = DITHER_M
         s.controller.reference.penetration_dither_hz = dither_hz
-        if source == "online":  # The surface from the slope, no EKF surface state.
+        if spec.source == "online":  # The surface from the slope, no EKF surface state.
             s.online_estimator.surface_from_slope = True
             s.online_estimator.surface_walk_m_per_sqrt_s = 0.0
-            s.online_estimator.slope_kappa_mode = "direct"
+            s.online_estimator.slope_kappa_mode = spec.slope_kappa_mode
     return s.validate()
 
 
@@ -207,9 +229,9 @@ def comparison_table(scores: dict) -> str:
 
 def main(argv=None) -> None:
     """``python -m vic_drake.experiments.online_compare SCENARIO [RUN ...]
-    [--dither-hz HZ]``: prints the table (every run of
+    [--dither-hz HZ] [--force-min-z N]``: prints the table (every run of
     :data:`COMPARISON_RUNS` by default; the dithered runs at HZ, default
-    :data:`DITHER_HZ`)."""
+    :data:`DITHER_HZ`; VS-VF's F_min,z at N, default the scenario's)."""
     import argparse
 
     from vic_drake.experiments.scan_diagram import load_scenario_phantom
@@ -224,11 +246,25 @@ def main(argv=None) -> None:
         default=DITHER_HZ,
         help=f"frequency of the dithered runs' dither, Hz (default {DITHER_HZ})",
     )
+    parser.add_argument(
+        "--force-min-z",
+        type=float,
+        default=None,
+        metavar="N",
+        help="VS-VF's F_min,z of every run, N (sensor convention, < 0; default: "
+        "the scenario's)",
+    )
     args = parser.parse_args(argv)
     unknown = [r for r in args.runs if r not in COMPARISON_RUNS]
     if unknown:
         parser.error(f"unknown runs {unknown}; choose from {list(COMPARISON_RUNS)}")
     base = load_scenario(args.scenario)
+    if args.force_min_z is not None:
+        base.controller.reference.force_min_z_N = args.force_min_z
+        try:
+            base = base.validate()
+        except VicDrakeError as exc:
+            parser.error(f"--force-min-z {args.force_min_z!r}: {exc}")
     runs = tuple(args.runs) or tuple(COMPARISON_RUNS)
     try:  # Check the frequency (even if no run is dithered) before a scan.
         comparison_scenario(base, "online_dither", dither_hz=args.dither_hz)
@@ -245,6 +281,7 @@ def main(argv=None) -> None:
 
 __all__ = [
     "COMPARISON_RUNS",
+    "ComparisonRun",
     "DITHER_HZ",
     "DITHER_M",
     "UNDITHERED_RUNS",
