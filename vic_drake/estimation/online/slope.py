@@ -51,8 +51,12 @@ says the stiffness is at its bound (``saturated``) and the last solve is
 not valid, ln kappa moves towards ``F / (s_hold - z)^beta``, with s_hold
 the last valid solve's own surface (mean z + eps at its mean time: its
 mean force, free of the dither's damping force). A still tip under a
-saturated stiffness does not move the force with the estimate, so this
-has no feedback loop; where the tip moves, the surface is not held (the
+saturated stiffness does not move the force with the estimate; but a
+higher kappa keeps the stiffness saturated, and where the tip rides up
+with a rising surface the rule raises kappa on and on. The force bound
+F_min,z caps the damage (-9 N); without a binding bound the rule runs
+away (docs/decisions.md, "The closed loop at the QP's own force bound").
+Where the tip moves, the surface is not held (the
 rib's exit of the measured phantom falls away under a held surface). In
 both cases ln kappa moves at most
 ``slope_kappa_max_rate_per_s``: a single biased solve (the fit reads the
