@@ -3,7 +3,9 @@
 import numpy as np
 import pytest
 
+from vic_drake.errors import VicDrakeError
 from vic_drake.estimation import PalpationData, load_test, predict_force
+from vic_drake.estimation.loadtest import check_roles
 from vic_drake.estimation.palpation import HuntCrossleyFit, KelvinVoigtFit
 from vic_drake.realdata import read_bag
 from vic_drake.tissue import hunt_crossley_force
@@ -131,3 +133,37 @@ def test_real_load_test_phases(data_dir, name):
     assert t[phases["load"]].max() == pytest.approx(0.75, abs=0.01)
     assert t[phases["unload"]].min() == pytest.approx(10.75, abs=0.01)
     assert t[phases["unload"]].max() == pytest.approx(12.25, abs=0.01)
+
+
+def with_target(data: PalpationData, z_target_m) -> PalpationData:
+    return PalpationData(
+        t_s=data.t_s,
+        z_m=data.z_m,
+        force_N=data.force_N,
+        surface_z_m=data.surface_z_m,
+        z_target_m=z_target_m,
+    )
+
+
+def test_load_test_refuses_logs_in_each_others_roles():
+    load = synthetic_load_test()
+    palpation = synthetic_palpation()
+    # Targets as the rig logs them: one descent and one rise; a sinusoid.
+    load = with_target(load, load.z_m)
+    palpation = with_target(
+        palpation, SURFACE_Z_M - 0.006 - 0.002 * np.sin(2 * np.pi * palpation.t_s)
+    )
+    with pytest.raises(VicDrakeError) as exc:
+        load_test(palpation, load, lag_s=0.0)
+    assert str(exc.value) == (
+        "the load test is not a load/unload test: its target does not descend once "
+        "and rise once (a palpation's goes up and down) (the two look swapped: the "
+        "palpation is the load/unload test)"
+    )
+    with pytest.raises(
+        VicDrakeError, match="^B is a load/unload test, not a palpation"
+    ):
+        load_test(load, load, lag_s=0.0, load_name="A", palpation_name="B")
+    # The right roles pass, and logs without a target are not checked.
+    check_roles(load, palpation)
+    check_roles(synthetic_load_test(), synthetic_palpation())

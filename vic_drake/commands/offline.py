@@ -89,35 +89,6 @@ def _read_palpation(path: Path):
     return PalpationData.from_frame(df)
 
 
-def _check_roles(load, palpation, load_text: str, palpation_text: str) -> None:
-    """Refuses a load test that is not a load cycle, or a palpation that is one
-    (the two arguments swapped), by the logs' targets
-    (:func:`vic_drake.estimation.loadtest.load_test_phases`)."""
-    from vic_drake.estimation.loadtest import load_test_phases
-
-    def is_cycle(data):
-        return load_test_phases(data.t_s, data.z_target_m) is not None
-
-    load_ok, palpation_is_cycle = is_cycle(load), is_cycle(palpation)
-    swap = (
-        " (the two look swapped: pass the load test as BAG_DIR and the palpation "
-        "as --fit-from)"
-        if not load_ok and palpation_is_cycle
-        else ""
-    )
-    if not load_ok:
-        raise VicDrakeError(
-            f"load-test bag {load_text!r} is not a load/unload test: its target does "
-            f"not descend once and rise once (a palpation's goes up and down){swap}"
-        )
-    if palpation_is_cycle:
-        raise VicDrakeError(
-            f"--fit-from {palpation_text!r} is a load/unload test, not a palpation: "
-            "the models are fitted on a sinusoidal palpation (e.g. "
-            "palpation/test_soft_1hz)"
-        )
-
-
 def _add_fit_options(parser: argparse.ArgumentParser) -> None:
     from vic_drake.estimation.palpation import (
         DEFAULT_INDENTER_MASS_KG,
@@ -246,7 +217,6 @@ def _load_test(args: argparse.Namespace) -> int:
     say(f"reading {load_path} and {fit_path}")
     load = _read_palpation(load_path)
     palpation = _read_palpation(fit_path)
-    _check_roles(load, palpation, args.bag_dir, args.fit_from)
     result = load_test(
         load,
         palpation,
@@ -255,6 +225,8 @@ def _load_test(args: argparse.Namespace) -> int:
         max_lag_s=max_lag,
         indenter_mass_kg=mass,
         progress=say,
+        load_name=f"load-test bag {args.bag_dir!r}",
+        palpation_name=f"--fit-from {args.fit_from!r}",
     )
     out = {
         "kelvin_voigt_rms_N": result.kelvin_voigt_rms_N,

@@ -125,6 +125,44 @@ class LoadTestResult:
     penetration_m: np.ndarray | None = None
 
 
+def check_roles(
+    load: PalpationData,
+    palpation: PalpationData,
+    *,
+    load_name: str = "the load test",
+    palpation_name: str = "the palpation",
+) -> None:
+    """Refuses a load test whose logged target is not a load cycle, or a
+    palpation whose logged target is one (the two swapped), by
+    :func:`load_test_phases`. A log without a target is not checked.
+
+    Raises:
+        VicDrakeError: naming the log (``load_name``, ``palpation_name``)
+            and what it should be.
+    """
+
+    def is_cycle(data: PalpationData) -> bool:
+        return load_test_phases(data.t_s, data.z_target_m) is not None
+
+    load_ok = load.z_target_m is None or is_cycle(load)
+    palpation_is_cycle = palpation.z_target_m is not None and is_cycle(palpation)
+    if not load_ok:
+        swap = (
+            f" (the two look swapped: {palpation_name} is the load/unload test)"
+            if palpation_is_cycle
+            else ""
+        )
+        raise VicDrakeError(
+            f"{load_name} is not a load/unload test: its target does not descend "
+            f"once and rise once (a palpation's goes up and down){swap}"
+        )
+    if palpation_is_cycle:
+        raise VicDrakeError(
+            f"{palpation_name} is a load/unload test, not a palpation: the models "
+            "are fitted on a sinusoidal palpation (e.g. palpation/test_soft_1hz)"
+        )
+
+
 def load_test(
     load: PalpationData,
     palpation: PalpationData,
@@ -135,6 +173,8 @@ def load_test(
     indenter_mass_kg: float = DEFAULT_INDENTER_MASS_KG,
     derivative_window_s: float = DEFAULT_DERIVATIVE_WINDOW_S,
     progress=None,
+    load_name: str = "the load test",
+    palpation_name: str = "the palpation",
 ) -> LoadTestResult:
     """Fits KV and HC on ``palpation`` and predicts the ``load`` test.
 
@@ -146,12 +186,15 @@ def load_test(
         max_lag_s: lag search range.
         indenter_mass_kg: m_I for both fit and prediction.
         progress: optional callable(str).
+        load_name, palpation_name: the two logs as the errors name them.
 
     Raises:
-        VicDrakeError: bad beta, too few in-contact samples in either log.
+        VicDrakeError: bad beta, the logs' roles swapped or wrong
+            (:func:`check_roles`), too few in-contact samples in either log.
     """
     say = progress or (lambda _msg: None)
     beta = _check_beta(beta)
+    check_roles(load, palpation, load_name=load_name, palpation_name=palpation_name)
     if lag_s is None:
         say("estimating the sensor lag on the palpation")
         lag_s = estimate_lag(
