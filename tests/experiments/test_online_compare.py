@@ -112,17 +112,24 @@ def test_true_references_with_and_without_the_dither():
     assert dithered == pytest.approx(expected)
 
 
-def test_dither_makes_the_map_free_controller_press_like_the_true_map():
-    # 9 s: 5.5 s of scanning over the first rib of the synthetic chest.
+def short_comparison(runs, duration_s, force_min_z_N=None):
+    """(base scenario, scores) of ``runs`` on the synthetic chest's first
+    ``duration_s`` seconds (F_min,z: the default unless given)."""
     from vic_drake.experiments.scan_diagram import load_scenario_phantom
 
     base = Scenario()
+    if force_min_z_N is not None:
+        base.controller.reference.force_min_z_N = force_min_z_N
+    base = base.validate()
     scores = online_comparison(
-        base,
-        phantom=load_scenario_phantom(base),
-        runs=("online", "online_dither"),
-        duration_s=9.0,
+        base, phantom=load_scenario_phantom(base), runs=runs, duration_s=duration_s
     )
+    return base, scores
+
+
+def test_dither_makes_the_map_free_controller_press_like_the_true_map():
+    # 9 s: 5.5 s of scanning over the first rib of the synthetic chest.
+    base, scores = short_comparison(("online", "online_dither"), 9.0)
     plain, dithered = scores["online"], scores["online_dither"]
     # Measured: 1.75 -> 0.41 N vs the true reference, the
     # dither's own swing included; penetration error 1.36 -> 0.53 mm (the
@@ -135,16 +142,8 @@ def test_dither_makes_the_map_free_controller_press_like_the_true_map():
 def test_tracker_beats_the_over_estimating_map_where_the_bound_does_not_cap():
     # F_min,z at the QP's own -15 N: the ribs' force is the controller's
     # choice, not the bound's. 12 s: the first rib of the synthetic chest.
-    from vic_drake.experiments.scan_diagram import load_scenario_phantom
-
-    base = Scenario()
-    base.controller.reference.force_min_z_N = -15.0
-    base = base.validate()
-    scores = online_comparison(
-        base,
-        phantom=load_scenario_phantom(base),
-        runs=("wrong_map_+30_dither", "online_dither_tracker"),
-        duration_s=12.0,
+    base, scores = short_comparison(
+        ("wrong_map_+30_dither", "online_dither_tracker"), 12.0, force_min_z_N=-15.0
     )
     wrong, online = scores["wrong_map_+30_dither"], scores["online_dither_tracker"]
     # Measured when written: 0.92 N against 1.74 N (the direct mode's
