@@ -42,6 +42,11 @@ Scores over the scan window (:func:`vic_drake.analysis.contact.scan_window`):
 - ``force_rmse_own_N``: RMS against the controller's own F_ref;
 - ``penetration_err_mm``: median |true penetration - eps_d| (the true
   surface under the probe minus the tip height; eps_d without the dither);
+- ``kappa_rel_err_median``: median |kappa_used / kappa_true - 1|, with
+  kappa_used = -F_ref,z / eps_d(t)^beta the stiffness the controller's
+  reference was made with (F_ref,z is logged before the cap; its damping
+  term averages out over a dither cycle): the online estimate for the
+  online runs, the map's kappa (x 1.3 for "wrong_map_+30") for the others;
 - ``rib_p99_force_N``: 99th percentile of the pressing force where the
   true kappa exceeds the rib threshold;
 - ``tank_min_J``: the lowest tank energy over the scan window (the tank
@@ -137,18 +142,26 @@ def true_references(df, phantom, scenario: Scenario) -> tuple[np.ndarray, np.nda
     run's dither: eps_d(t) and F_min,z(t) as
     :func:`vic_drake.control.references.force_references` form them.
     """
-    x, y, t = (df[c].to_numpy(float) for c in ("x_m", "y_m", "t_s"))
+    x, y = (df[c].to_numpy(float) for c in ("x_m", "y_m"))
     kappa = np.asarray(phantom.sample(x, y).kappa)
     ref = scenario.controller.reference
     beta = phantom.beta
     plain = np.maximum(-kappa * ref.eps_d_m**beta, ref.force_min_z_N)
     if ref.penetration_dither_m == 0.0:
         return plain, plain
-    eps_d = ref.eps_d_m + ref.penetration_dither_m * np.sin(
-        2.0 * np.pi * ref.penetration_dither_hz * t
-    )
+    eps_d = desired_penetrations(df, scenario)
     f_min = ref.force_min_z_N * np.minimum(1.0, (eps_d / ref.eps_d_m) ** beta)
     return plain, np.maximum(-kappa * eps_d**beta, f_min)
+
+
+def desired_penetrations(df, scenario: Scenario) -> np.ndarray:
+    """eps_d(t) of every row, m: eps_d with the run's dither
+    (:func:`vic_drake.control.references.desired_penetration`)."""
+    ref = scenario.controller.reference
+    t = df["t_s"].to_numpy(float)
+    return ref.eps_d_m + ref.penetration_dither_m * np.sin(
+        2.0 * np.pi * ref.penetration_dither_hz * t
+    )
 
 
 def _rms(values: np.ndarray, sel: np.ndarray) -> float:
@@ -171,12 +184,23 @@ def score_against_truth(df, phantom, scenario: Scenario) -> dict:
     pen = np.asarray(tissue.surface_z_m) - z - df["phantom_lift_m"].to_numpy(float)
     rib = window & (np.asarray(tissue.kappa) > RIB_KAPPA_THRESHOLD)
     pressing = pressing_force_N(df)
+    # The stiffness the controller's reference was made with: F_ref,z is
+    # logged before the F_min,z cap, so -F_ref,z / eps_d(t)^beta is the
+    # controller's kappa (its damping term lam eps_dot included, which
+    # averages out over a dither cycle).
+    kappa_used = -df["force_ref_z_N"].to_numpy(float) / (
+        desired_penetrations(df, scenario) ** phantom.beta
+    )
+    kappa_err = np.abs(kappa_used / np.asarray(tissue.kappa) - 1.0)
     return {
         "force_rmse_true_N": _rms(err, sel),
         "force_rmse_dithered_truth_N": _rms(force - f_dithered, sel),
         "dither_rms_N": _rms(f_dithered - f_true, sel),
         "force_rmse_own_N": force_rmse_N(df),
         "penetration_err_mm": float(np.median(np.abs(pen[sel] - ref.eps_d_m)) * 1e3)
+        if sel.any()
+        else np.nan,
+        "kappa_rel_err_median": float(np.median(kappa_err[sel]))
         if sel.any()
         else np.nan,
         "rib_p99_force_N": float(np.percentile(pressing[rib], 99))
@@ -214,6 +238,7 @@ def comparison_table(scores: dict) -> str:
         ("force_rmse_dithered_truth_N", "vs dithered truth N", 3),
         ("dither_rms_N", "dither RMS N", 3),
         ("penetration_err_mm", "penetration err mm", 2),
+        ("kappa_rel_err_median", "kappa err (median)", 3),
         ("rib_p99_force_N", "p99 force on ribs N", 2),
         ("tank_min_J", "tank min J", 3),
     )
@@ -287,6 +312,7 @@ __all__ = [
     "UNDITHERED_RUNS",
     "comparison_scenario",
     "comparison_table",
+    "desired_penetrations",
     "main",
     "online_comparison",
     "score_against_truth",
