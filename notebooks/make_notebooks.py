@@ -352,10 +352,10 @@ ax.set_xlabel("t [s]"); ax.set_ylabel("kappa"); ax.legend()"""
             "With the rig's F_min,z of -9 N the force over the ribs sits at that "
             "bound in every run, so the p99 force there is the bound's. The second "
             "table sets F_min,z to the QP's own -15 N: the ribs' force is then the "
-            "controller's choice, and there the direct mode's estimate runs away "
-            "while the tracker's follows the tissue (docs/decisions.md, \"The "
-            "closed loop at the QP's own force bound\"). Shortened in the test "
-            "suite's short mode."
+            "controller's choice: there the tracker wins and the direct mode "
+            "loses, its saturation rule over-reading kappa while the tip rides up "
+            "a rib (docs/decisions.md, \"The closed loop at the QP's own force "
+            "bound\"). Shortened in the test suite's short mode."
         ),
         new_code_cell(
             """\

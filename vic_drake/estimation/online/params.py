@@ -103,9 +103,11 @@ class OnlineEstimatorParams:
             filter; kappa follows the force) or "direct" (kappa from the
             fit's valid solves, held between them, relaxed towards the
             force at the held surface while the stiffness is saturated;
-            the surface z + (F / kappa)^(1 / beta)); "direct" needs a
-            force bound that caps the reference, or its saturation rule
-            runs away. See :mod:`~vic_drake.estimation.online.slope`.
+            the surface z + (F / kappa)^(1 / beta)); "direct" wins where
+            the force bound caps the reference on the ribs, "tracker"
+            where it does not (docs/decisions.md, "The closed loop at the
+            QP's own force bound"). See
+            :mod:`~vic_drake.estimation.online.slope`.
         slope_kappa_max_rate_per_s: "direct" mode: ln kappa moves at most
             this fast, 1/s (the tissue under the probe at scan speed
             changes its ln kappa by at most ~0.5/s on both phantoms).

@@ -50,12 +50,15 @@ kappa stays where it was while the tissue changes. So while the caller
 says the stiffness is at its bound (``saturated``) and the last solve is
 not valid, ln kappa moves towards ``F / (s_hold - z)^beta``, with s_hold
 the last valid solve's own surface (mean z + eps at its mean time: its
-mean force, free of the dither's damping force). A still tip under a
-saturated stiffness does not move the force with the estimate; but a
-higher kappa keeps the stiffness saturated, and where the tip rides up
-with a rising surface the rule raises kappa on and on. The force bound
-F_min,z caps the damage (-9 N); without a binding bound the rule runs
-away (docs/decisions.md, "The closed loop at the QP's own force bound").
+mean force, free of the dither's damping force). Where the tip has
+risen above the depth of that solve, the held surface would read the
+rise as a stiffer tissue, while a surface rising under the tip (a rib)
+explains it as well; the rule then takes the softer of the two readings,
+the depth held: ``F / max(s_hold - z, eps_hold)^beta``. A still tip under
+a saturated stiffness does not move the force with the estimate; but a
+higher kappa keeps the stiffness saturated, so the held surface alone
+ran away where the force bound F_min,z does not cap the reference
+(docs/decisions.md, "The saturation rule takes the softer reading").
 Where the tip moves, the surface is not held (the
 rib's exit of the measured phantom falls away under a held surface). In
 both cases ln kappa moves at most
@@ -107,7 +110,8 @@ _V_OUT = _S_OUT + 1  # its rate, m/s
 _KAPPA = _V_OUT + 1  # F / eps^beta of the last valid solve (NaN: none)
 _LN_KAPPA = _KAPPA + 1  # "direct": the output ln kappa (NaN: none)
 _S_HOLD = _LN_KAPPA + 1  # "direct": the last valid solve's surface, m
-SLOPE_SIZE = _S_HOLD + 1
+_EPS_HOLD = _S_HOLD + 1  # "direct": the last valid solve's penetration, m
+SLOPE_SIZE = _EPS_HOLD + 1
 #: Index of the tracked surface in the state (:func:`advance`).
 SURFACE = _S_OUT
 
@@ -140,7 +144,7 @@ def slope_initial_state() -> list[float]:
     state = [0.0] * SLOPE_SIZE
     for i in (
         _T_REF, _T_START, _T_LAST, _SLOPE, _REL_STD, _EPS, _Z_MEAN, _T_MEAN, _S_OUT,
-        _KAPPA, _LN_KAPPA, _S_HOLD,
+        _KAPPA, _LN_KAPPA, _S_HOLD, _EPS_HOLD,
     ):  # fmt: skip
         state[i] = math.nan
     return state
@@ -203,7 +207,9 @@ def _direct(
     if valid:
         target = math.log(s[_KAPPA])
     elif saturated and eps_hold > 0.0:  # (False when NaN)
-        target = math.log(force) - p.beta * math.log(eps_hold)
+        # The softer of the two readings: the surface held, or the depth
+        # held where the tip has risen above it.
+        target = math.log(force) - p.beta * math.log(max(eps_hold, s[_EPS_HOLD]))
     else:
         target = held
     if math.isnan(held):
@@ -216,6 +222,7 @@ def _direct(
     s[_V_OUT] = 0.0
     if valid:  # The fit's own surface (its mean force: no dither damping).
         s[_S_HOLD] = s[_Z_MEAN] + s[_EPS]
+        s[_EPS_HOLD] = s[_EPS]
 
 
 def slope_step(
