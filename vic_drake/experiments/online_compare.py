@@ -144,12 +144,17 @@ def true_references(df, phantom, scenario: Scenario) -> tuple[np.ndarray, np.nda
     """
     x, y = (df[c].to_numpy(float) for c in ("x_m", "y_m"))
     kappa = np.asarray(phantom.sample(x, y).kappa)
+    return _true_references(
+        kappa, desired_penetrations(df, scenario), scenario, phantom.beta
+    )
+
+
+def _true_references(kappa, eps_d, scenario: Scenario, beta: float):
+    """:func:`true_references` from the true kappa and eps_d(t) of every row."""
     ref = scenario.controller.reference
-    beta = phantom.beta
     plain = np.maximum(-kappa * ref.eps_d_m**beta, ref.force_min_z_N)
     if ref.penetration_dither_m == 0.0:
         return plain, plain
-    eps_d = desired_penetrations(df, scenario)
     f_min = ref.force_min_z_N * np.minimum(1.0, (eps_d / ref.eps_d_m) ** beta)
     return plain, np.maximum(-kappa * eps_d**beta, f_min)
 
@@ -173,25 +178,25 @@ def score_against_truth(df, phantom, scenario: Scenario) -> dict:
     window = scan_window(df)
     x, y, z = (df[c].to_numpy(float) for c in ("x_m", "y_m", "z_m"))
     tissue = phantom.sample(x, y)
+    kappa_true = np.asarray(tissue.kappa)
+    eps_d = desired_penetrations(df, scenario)
     ref = scenario.controller.reference
     # The VS-VF reference on the true tissue (sensor convention: pressing
     # is negative).
-    f_true, f_dithered = true_references(df, phantom, scenario)
+    f_true, f_dithered = _true_references(kappa_true, eps_d, scenario, phantom.beta)
     force = df["force_sensor_z_N"].to_numpy(float)
     err = force - f_true
     contact = df["in_contact"].to_numpy(float) > 0.5
     sel = window & contact & np.isfinite(err)
     pen = np.asarray(tissue.surface_z_m) - z - df["phantom_lift_m"].to_numpy(float)
-    rib = window & (np.asarray(tissue.kappa) > RIB_KAPPA_THRESHOLD)
+    rib = window & (kappa_true > RIB_KAPPA_THRESHOLD)
     pressing = pressing_force_N(df)
     # The stiffness the controller's reference was made with: F_ref,z is
     # logged before the F_min,z cap, so -F_ref,z / eps_d(t)^beta is the
     # controller's kappa (its damping term lam eps_dot included, which
     # averages out over a dither cycle).
-    kappa_used = -df["force_ref_z_N"].to_numpy(float) / (
-        desired_penetrations(df, scenario) ** phantom.beta
-    )
-    kappa_err = np.abs(kappa_used / np.asarray(tissue.kappa) - 1.0)
+    kappa_used = -df["force_ref_z_N"].to_numpy(float) / eps_d**phantom.beta
+    kappa_err = np.abs(kappa_used / kappa_true - 1.0)
     return {
         "force_rmse_true_N": _rms(err, sel),
         "force_rmse_dithered_truth_N": _rms(force - f_dithered, sel),
