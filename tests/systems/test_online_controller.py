@@ -163,7 +163,7 @@ def test_controller_refuses_the_slope_surface_without_the_dither():
 
 
 @pytest.mark.parametrize("mode", ["tracker", "direct"])
-def test_direct_slope_mode_reads_the_qp_stiffness(mode):
+def test_slope_fit_reads_the_controllers_bounds(mode):
     params = ControllerParams(
         qp=StiffnessQpParams(solver="exact"),
         reference=ReferenceParams(
@@ -182,25 +182,42 @@ def test_direct_slope_mode_reads_the_qp_stiffness(mode):
     diagram = MakeVariableImpedanceController(
         params, phantom=None, stiffness_source="online", estimator=estimator
     )
-    port = diagram.GetSubsystemByName("tissue_estimator").get_stiffness_input_port()
-    # "direct" relaxes its held kappa while K_z is at K_max: the estimator
-    # reads the QP's K (connected: the ticks evaluate it).
-    assert (port is not None) == (mode == "direct")
+    est = diagram.GetSubsystemByName("tissue_estimator")
+    # Both modes read the QP's K (K_z at K_max) and the references (F_ref,z
+    # capped by F_min,z); connected: the ticks evaluate them.
+    assert est.get_stiffness_input_port() is not None
+    assert est.get_references_input_port() is not None
     context = _run_ticks(diagram, 20)
     est = diagram.GetOutputPort("tissue_estimate").Eval(context)
     assert np.all(np.isfinite(est[:5]))
 
 
-def test_estimator_stiffness_input_needs_the_slope_fit():
+@pytest.mark.parametrize("name, bad", [("stiffness_max_z", 0.0), ("force_min_z", 9.0)])
+def test_estimator_bound_inputs_need_the_slope_fit(name, bad):
     from vic_drake.systems.online_estimator import OnlineEstimatorSystem
 
-    with pytest.raises(VicDrakeError, match="stiffness_max_z is for"):
+    with pytest.raises(VicDrakeError, match=f"{name} is for"):
         OnlineEstimatorSystem(
-            OnlineEstimatorParams(method="ekf"), period_s=0.002, stiffness_max_z=1e3
+            OnlineEstimatorParams(method="ekf"), period_s=0.002, **{name: -1e3}
         )
-    with pytest.raises(VicDrakeError, match="stiffness_max_z must be > 0"):
+    with pytest.raises(VicDrakeError, match=f"{name} must be"):
         OnlineEstimatorSystem(
             OnlineEstimatorParams(method="ekf", surface_from_slope=True),
             period_s=0.002,
-            stiffness_max_z=0.0,
+            **{name: bad},
         )
+
+
+@pytest.mark.parametrize(
+    "f_ref, f_min, flat",
+    [
+        (-10.0, -9.0, True),  # capped, the dither's upper half: the bound
+        (-10.0, -8.5, False),  # capped, lower half: the bound follows it
+        (-8.0, -9.0, False),  # not capped
+        (0.0, -30.0, False),  # out of contact (F_min,z = -F_max,z)
+    ],
+)
+def test_flat_force_bound(f_ref, f_min, flat):
+    from vic_drake.systems.online_estimator import at_flat_force_bound
+
+    assert at_flat_force_bound(f_ref, f_min, -9.0) is flat

@@ -116,7 +116,7 @@ def MakeVariableImpedanceController(
                 "the estimator's surface_from_slope needs the reference's dither "
                 "(reference.penetration_dither_m > 0); got 0.0"
             )
-    reads_stiffness = online and estimator.reads_stiffness
+    reads_bounds = online and estimator.reads_controller_bounds
     builder = DiagramBuilder()
     ref = builder.AddNamedSystem(
         "force_reference",
@@ -136,8 +136,9 @@ def MakeVariableImpedanceController(
                 surface_input=False,
                 surface_map=phantom if online_surface == "map" else None,
                 stiffness_max_z=params.qp.stiffness_max_N_per_m[2]
-                if reads_stiffness
+                if reads_bounds
                 else None,
+                force_min_z=params.reference.force_min_z_N if reads_bounds else None,
             ),
         )
         builder.Connect(
@@ -145,8 +146,13 @@ def MakeVariableImpedanceController(
         )
         builder.ExportOutput(est.get_estimate_output_port(), "tissue_estimate")
     qp = builder.AddNamedSystem("stiffness_qp", StiffnessQpSystem(params))
-    if reads_stiffness:  # (K from state: the last tick's, no algebraic loop)
+    if reads_bounds:  # (K from state: the last tick's, no algebraic loop)
         builder.Connect(qp.get_stiffness_output_port(), est.get_stiffness_input_port())
+        # (The estimator reads the references in its update only: no loop
+        # through its estimate, a state output.)
+        builder.Connect(
+            ref.get_references_output_port(), est.get_references_input_port()
+        )
     tank = builder.AddNamedSystem("energy_tank", EnergyTankSystem(params))
 
     # The reference system reads the three measured vectors as one, built by

@@ -27,6 +27,9 @@ from vic_drake.systems.signals import (
     MEASURED_POSITION,
     MEASURED_VELOCITY,
     MEASUREMENT_SIZE,
+    REF_FORCE_MIN,
+    REF_FORCE_REFERENCE,
+    REFERENCES_SIZE,
 )
 
 #: Where the estimator's scalars sit in the "measurement" vector: the probe
@@ -37,6 +40,20 @@ _FZ = MEASURED_FORCE.start + 2
 
 #: K_z counts as at its bound from this fraction below it.
 SATURATION_REL_TOL = 1e-3
+#: F_ref,z and F_min,z in the "references" vector.
+_F_REF_Z = REF_FORCE_REFERENCE.start + 2
+_F_MIN_Z = REF_FORCE_MIN.start + 2
+
+
+def at_flat_force_bound(
+    force_ref_z_N: float, force_min_z_N: float, bound_z_N: float
+) -> bool:
+    """Whether the controller holds the z force at a bound that does not
+    follow the dither: the reference is capped by F_min,z (sensor
+    convention: below it) while F_min,z is at the scenario's ``bound_z_N``
+    (the dither lowers it only in its lower half-cycle)."""
+    return force_ref_z_N < force_min_z_N <= bound_z_N
+
 
 #: Index of each field in the "estimate" output.
 ESTIMATE_SIZE = len(OUTPUT_FIELDS)
@@ -58,9 +75,14 @@ class OnlineEstimatorSystem(LeafSystem):
             surface state is on), or, with ``surface_map`` (a Phantom), read
             from the map under the probe.
         stiffness (3): the controller's stiffness K, N/m (only with
-            ``stiffness_max_z``): the slope fit's "direct" mode relaxes its
-            held kappa while K_z is at ``stiffness_max_z``
+            ``stiffness_max_z``): the slope fit relaxes its held kappa while
+            K_z is at ``stiffness_max_z``
             (:mod:`vic_drake.estimation.online.slope`).
+        references (``signals.REFERENCES_SIZE``): the force reference
+            system's "references" output (only with ``force_min_z``): the
+            slope fit's "tracker" mode leaves out the samples at which F_ref,z
+            is capped by F_min,z while F_min,z is at ``force_min_z``
+            (:func:`at_flat_force_bound`).
 
     Output ports (state: the last tick's estimate):
         estimate (7): :data:`vic_drake.estimation.online.OUTPUT_FIELDS`.
@@ -79,6 +101,7 @@ class OnlineEstimatorSystem(LeafSystem):
         surface_input: bool = True,
         surface_map=None,
         stiffness_max_z: float | None = None,
+        force_min_z: float | None = None,
     ):
         super().__init__()
         if not isinstance(params, OnlineEstimatorParams):
@@ -105,10 +128,14 @@ class OnlineEstimatorSystem(LeafSystem):
         self._surface_lookup = (
             None if surface_map is None else surface_map.point_lookup()
         )
-        if stiffness_max_z is not None and not self._params.surface_from_slope:
-            raise VicDrakeError(
-                "stiffness_max_z is for the estimator's surface_from_slope; it is off"
-            )
+        for name, value in (
+            ("stiffness_max_z", stiffness_max_z),
+            ("force_min_z", force_min_z),
+        ):
+            if value is not None and not self._params.surface_from_slope:
+                raise VicDrakeError(
+                    f"{name} is for the estimator's surface_from_slope; it is off"
+                )
         self._stiffness_port = None
         if stiffness_max_z is not None:
             if not (math.isfinite(stiffness_max_z) and stiffness_max_z > 0.0):
@@ -117,6 +144,16 @@ class OnlineEstimatorSystem(LeafSystem):
                 )
             self._stiffness_port = self.DeclareVectorInputPort("stiffness", 3)
             self._k_saturated = stiffness_max_z * (1.0 - SATURATION_REL_TOL)
+        self._references_port = None
+        if force_min_z is not None:
+            if not (math.isfinite(force_min_z) and force_min_z < 0.0):
+                raise VicDrakeError(
+                    f"force_min_z must be < 0 (sensor convention); got {force_min_z!r}"
+                )
+            self._references_port = self.DeclareVectorInputPort(
+                "references", REFERENCES_SIZE
+            )
+            self._force_min_z = force_min_z
         self._filter = self.DeclareDiscreteState(np.asarray(state0, float))
         self._estimate = self.DeclareDiscreteState(np.asarray(est0, float))
         self.DeclarePeriodicDiscreteUpdateEvent(float(period_s), 0.0, self._update)
@@ -153,11 +190,19 @@ class OnlineEstimatorSystem(LeafSystem):
         # this handler: the filter state is read from it and written in place.
         state = discrete_state.value(self._filter).tolist()
         args = (state, context.get_time(), m[_Z], m[_VZ], -m[_FZ], s, self._params)
-        if self._stiffness_port is None:
+        if self._stiffness_port is None and self._references_port is None:
             state, est = self._step(*args)
         else:
-            k_z = float(self._stiffness_port.Eval(context)[2])
-            state, est = self._step(*args, k_z >= self._k_saturated)
+            saturated = at_bound = False
+            if self._stiffness_port is not None:
+                k_z = float(self._stiffness_port.Eval(context)[2])
+                saturated = k_z >= self._k_saturated
+            if self._references_port is not None:
+                r = self._references_port.Eval(context)
+                at_bound = at_flat_force_bound(
+                    float(r[_F_REF_Z]), float(r[_F_MIN_Z]), self._force_min_z
+                )
+            state, est = self._step(*args, saturated, at_bound)
         discrete_state.get_mutable_value(self._filter)[:] = state
         discrete_state.get_mutable_value(self._estimate)[:] = est
 
@@ -167,6 +212,10 @@ class OnlineEstimatorSystem(LeafSystem):
     def get_stiffness_input_port(self):
         """The "stiffness" input (None without ``stiffness_max_z``)."""
         return self._stiffness_port
+
+    def get_references_input_port(self):
+        """The "references" input (None without ``force_min_z``)."""
+        return self._references_port
 
     def get_estimate_output_port(self):
         return self._ports["estimate"]

@@ -6,28 +6,14 @@ held surface while the stiffness is saturated, and never faster than
 import numpy as np
 import pytest
 
+from tests.estimation.online.hc_data import SLOPE_BETA as BETA
+from tests.estimation.online.hc_data import SLOPE_DT as DT
+from tests.estimation.online.hc_data import SLOPE_KAPPA as KAPPA
+from tests.estimation.online.hc_data import SLOPE_LAM as LAM
+from tests.estimation.online.hc_data import softening_under_a_still_tip
 from vic_drake.errors import VicDrakeError
 from vic_drake.estimation.online import OnlineEstimatorParams
 from vic_drake.estimation.online.slope import slope_initial_state, slope_step
-
-KAPPA, LAM, BETA = 6000.0, 40000.0, 1.35
-DT = 0.002
-
-
-def _softening_under_a_still_tip(*, seed=0, noise_N=0.045):
-    """3 s dithered at 6 mm on a flat surface, then the tip still (a
-    saturated stiffness stops it); from 3.5 s (the fit's window has no
-    dither left) kappa falls to 0.6 x over 1 s.
-    (t, z, z_dot, force, kappa)."""
-    rng = np.random.default_rng(seed)
-    t = np.arange(0.0, 6.0, DT)
-    w = 2.0 * np.pi * 3.0
-    on = t < 3.0
-    eps = 0.006 + np.where(on, 3e-4 * np.sin(w * t), 0.0)
-    eps_dot = np.where(on, 3e-4 * w * np.cos(w * t), 0.0)
-    kappa = KAPPA * (1.0 - 0.4 * np.clip(t - 3.5, 0.0, 1.0))
-    force = (kappa + LAM * eps_dot) * eps**BETA + rng.normal(0.0, noise_N, t.size)
-    return t, 0.1 - eps, -eps_dot, force, kappa
 
 
 def _direct_kappa(t, z, v, f, saturated, params):
@@ -50,7 +36,7 @@ PARAMS = OnlineEstimatorParams(
 
 @pytest.mark.parametrize("seed", [0, 1])
 def test_held_kappa_relaxes_only_while_the_stiffness_is_saturated(seed):
-    t, z, v, f, truth = _softening_under_a_still_tip(seed=seed)
+    t, z, v, f, truth = softening_under_a_still_tip(seed=seed)
     still = t >= 3.0
     held, valid = _direct_kappa(t, z, v, f, np.zeros(t.size), PARAMS)
     relaxed, _ = _direct_kappa(t, z, v, f, still, PARAMS)
@@ -66,7 +52,7 @@ def test_held_kappa_relaxes_only_while_the_stiffness_is_saturated(seed):
 
 
 def test_ln_kappa_moves_at_most_at_the_rate_bound():
-    t, z, v, f, _ = _softening_under_a_still_tip()
+    t, z, v, f, _ = softening_under_a_still_tip()
     params = OnlineEstimatorParams(
         method="ekf",
         surface_from_slope=True,

@@ -166,17 +166,19 @@ def ekf_slope_step(
     surface_z: float,
     params: OnlineEstimatorParams,
     saturated: bool = False,
+    at_force_bound: bool = False,
 ) -> tuple[list[float], Estimate]:
     """:func:`ekf_step` on the slope fit's surface when ``surface_z`` is NaN
-    (arguments and result as :func:`ekf_step`; ``saturated``: the
-    controller's stiffness is at its bound, for the fit's "direct" mode,
+    (arguments and result as :func:`ekf_step`; ``saturated`` and
+    ``at_force_bound``: the controller's stiffness and force at their
+    bounds, for the fit,
     :func:`~vic_drake.estimation.online.slope.slope_step`)."""
     p = params
     if type(state) is not list:  # (slices of an array would be views)
         state = list(state)
     size = state_size(ekf_layout(p)[0])
     fit = state[size:]
-    advance(fit, t, z, z_dot, force, p, state[S_PREV], saturated)
+    advance(fit, t, z, z_dot, force, p, state[S_PREV], saturated, at_force_bound)
     if math.isnan(surface_z):
         surface_z = fit[SURFACE]
     ekf_state, est = ekf_step(state[:size], t, z, z_dot, force, surface_z, p)

@@ -103,14 +103,14 @@ class OnlineEstimatorParams:
             filter; kappa follows the force) or "direct" (kappa from the
             fit's valid solves, held between them, relaxed towards the
             force at the held surface while the stiffness is saturated;
-            the surface z + (F / kappa)^(1 / beta)); "direct" wins where
-            the force bound caps the reference on the ribs, "tracker"
-            where it does not (docs/decisions.md, "The closed loop at the
-            QP's own force bound"). See
-            :mod:`~vic_drake.estimation.online.slope`.
-        slope_kappa_max_rate_per_s: "direct" mode: ln kappa moves at most
-            this fast, 1/s (the tissue under the probe at scan speed
-            changes its ln kappa by at most ~0.5/s on both phantoms).
+            the surface z + (F / kappa)^(1 / beta)); see
+            :mod:`~vic_drake.estimation.online.slope` and, for where each
+            wins, docs/decisions.md ("The tracker at the controller's
+            bounds").
+        slope_kappa_max_rate_per_s: ln kappa moves at most this fast under
+            a saturated stiffness (both modes) and, in "direct" mode, from
+            the valid solves too, 1/s (the tissue under the probe at scan
+            speed changes its ln kappa by at most ~0.5/s on both phantoms).
     """
 
     method: str = "rls"
@@ -148,10 +148,11 @@ class OnlineEstimatorParams:
         self.validate()
 
     @property
-    def reads_stiffness(self) -> bool:
-        """Whether the estimator reads the controller's stiffness: the slope
-        fit's "direct" mode relaxes its held kappa while K_z is saturated."""
-        return self.surface_from_slope and self.slope_kappa_mode == "direct"
+    def reads_controller_bounds(self) -> bool:
+        """Whether the estimator reads whether the controller's stiffness
+        and force are at their bounds: the slope fit does
+        (:mod:`~vic_drake.estimation.online.slope`)."""
+        return self.surface_from_slope
 
     def validate(self) -> "OnlineEstimatorParams":
         """Checks every field; returns self (raises VicDrakeError naming it)."""

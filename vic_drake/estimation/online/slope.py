@@ -41,16 +41,34 @@ rate) through a second-order filter (see :func:`slope_step`). Everything
 restarts at each loss of contact.
 
 That is the "tracker" mode (``slope_kappa_mode``): the surface is smooth
-and kappa follows the force. The "direct" mode holds kappa instead:
+and kappa follows the force. Two flags from the controller's side change
+it at the controller's bounds (docs/decisions.md, "The tracker at the
+controller's bounds"):
+
+- a sample taken while the controller holds the force at a bound that
+  does not follow the dither (``at_force_bound``: VS-VF's F_min,z in the
+  dither's upper half-cycle) is not fitted. Its force is the controller's
+  choice, not the tissue's answer to the tip's motion, and such samples
+  read the slope low on the ribs;
+- while the stiffness is at its bound (``saturated``), a solve that is
+  not valid moves the held kappa down towards ``F / (s_hold - z)^beta``
+  where that reading is the softer one (F and z the solve's mean force
+  and tip height: read from each sample, the force's noise would ratchet
+  kappa down). s_hold is the last valid solve's own surface (mean z + eps
+  at its mean time: its mean force, free of the dither's damping force).
+  A kappa held too high asks more force than the saturated stiffness
+  gives, the tip stops, and no solve is valid again: the held surface is
+  then the only reading of a tissue that softens.
+
+The "direct" mode holds kappa instead (and fits every sample):
 ln kappa follows the valid solves' F / eps^beta, is held while the solves
 are not valid, and the output surface is ``z + (F / kappa)^(1 / beta)``
 (the EKF downstream then reads that kappa back). A held kappa is a trap
 where the stiffness saturates: the tip stops, no solve is valid again and
 kappa stays where it was while the tissue changes. So while the caller
 says the stiffness is at its bound (``saturated``) and the last solve is
-not valid, ln kappa moves towards ``F / (s_hold - z)^beta``, with s_hold
-the last valid solve's own surface (mean z + eps at its mean time: its
-mean force, free of the dither's damping force). Where the tip has
+not valid, ln kappa moves towards ``F / (s_hold - z)^beta`` (s_hold as
+above; F and z this sample's), up or down. Where the tip has
 risen above the depth of that solve, the held surface would read the
 rise as a stiffer tissue, while a surface rising under the tip (a rib)
 explains it as well; the rule then takes the softer of the two readings,
@@ -61,7 +79,7 @@ ran away where the force bound F_min,z does not cap the reference
 (docs/decisions.md, "The saturation rule takes the softer reading").
 Where the tip moves, the surface is not held (the
 rib's exit of the measured phantom falls away under a held surface). In
-both cases ln kappa moves at most
+every case ln kappa moves at most
 ``slope_kappa_max_rate_per_s``: a single biased solve (the fit reads the
 loop's own large motions worst) moves the estimate by a bounded step.
 """
@@ -109,8 +127,8 @@ _S_OUT = _T_MEAN + 1  # the tracked surface, m (NaN: none)
 _V_OUT = _S_OUT + 1  # its rate, m/s
 _KAPPA = _V_OUT + 1  # F / eps^beta of the last valid solve (NaN: none)
 _LN_KAPPA = _KAPPA + 1  # "direct": the output ln kappa (NaN: none)
-_S_HOLD = _LN_KAPPA + 1  # "direct": the last valid solve's surface, m
-_EPS_HOLD = _S_HOLD + 1  # "direct": the last valid solve's penetration, m
+_S_HOLD = _LN_KAPPA + 1  # the last valid solve's surface, m
+_EPS_HOLD = _S_HOLD + 1  # the last valid solve's penetration, m
 SLOPE_SIZE = _EPS_HOLD + 1
 #: Index of the tracked surface in the state (:func:`advance`).
 SURFACE = _S_OUT
@@ -150,8 +168,29 @@ def slope_initial_state() -> list[float]:
     return state
 
 
-def _solve(s: list[float], t: float, p: OnlineEstimatorParams) -> None:
+def _soften_held_kappa(
+    s: list[float], force: float, dt: float, p: OnlineEstimatorParams
+) -> None:
+    """The "tracker" mode's invalid solve under a saturated stiffness (in
+    place): the held kappa moves down towards ``F / (s_hold - z)^beta``
+    (the solve's mean force and tip height) where that reading is the
+    softer one, at most at the rate bound over ``dt`` (since the last
+    solve)."""
+    eps = s[_S_HOLD] - s[_Z_MEAN]
+    if not eps > 0.0:
+        return
+    held = math.log(s[_KAPPA])
+    target = math.log(force) - p.beta * math.log(eps)
+    if target < held:
+        s[_KAPPA] = math.exp(max(target, held - p.slope_kappa_max_rate_per_s * dt))
+
+
+def _solve(s: list[float], t: float, p: OnlineEstimatorParams, saturated: bool) -> None:
     """Re-centres the sums on t and the mean heights, then solves (in place)."""
+    if not s[_G] > 0.0:  # Every sample since the reset was at the force bound.
+        s[_T_REF] = t
+        s[_COUNT] = 0.0
+        return
     d = t - s[_T_REF]
     dz = -s[_G + _Z] / s[_G]  # mean z - z0 (G04 / G00 = mean of z0 - z)
     sums = shift_basis(s[_G : _FF + 1], d, dz, math.exp(-d / p.slope_memory_s))
@@ -185,7 +224,12 @@ def _solve(s: list[float], t: float, p: OnlineEstimatorParams) -> None:
         s[_VALID] = 1.0
         s[_EPS] = eps
         s[_KAPPA] = force / eps**p.beta
-    elif force > 0.0 and math.isfinite(s[_KAPPA]):  # Not valid: kappa held.
+        # The solve's own surface and depth (its mean force: no dither damping).
+        s[_S_HOLD] = s[_Z_MEAN] + eps
+        s[_EPS_HOLD] = eps
+    elif force > 0.0 and math.isfinite(s[_KAPPA]):  # Not valid: kappa held,
+        if saturated and p.slope_kappa_mode == "tracker":
+            _soften_held_kappa(s, force, d, p)
         s[_EPS] = (force / s[_KAPPA]) ** (1.0 / p.beta)
 
 
@@ -220,9 +264,6 @@ def _direct(
     s[_LN_KAPPA] = ln_kappa
     s[_S_OUT] = z + (force / math.exp(ln_kappa)) ** (1.0 / p.beta)
     s[_V_OUT] = 0.0
-    if valid:  # The fit's own surface (its mean force: no dither damping).
-        s[_S_HOLD] = s[_Z_MEAN] + s[_EPS]
-        s[_EPS_HOLD] = s[_EPS]
 
 
 def slope_step(
@@ -234,6 +275,7 @@ def slope_step(
     params: OnlineEstimatorParams,
     surface_start: float = math.nan,
     saturated: bool = False,
+    at_force_bound: bool = False,
 ) -> tuple[list[float], SlopeEstimate]:
     """One sample of the fit and of the surface it measures.
 
@@ -259,14 +301,17 @@ def slope_step(
         params: ``slope_memory_s``, ``slope_min_motion_m``,
             ``slope_surface_time_s``, ``beta``, ``contact_threshold_N``.
         surface_start: see above, m ("tracker" mode).
-        saturated: the controller's stiffness is at its bound ("direct"
-            mode: see the module docstring).
+        saturated: the controller's stiffness is at its bound (see the
+            module docstring).
+        at_force_bound: the controller holds the force at a bound that
+            does not follow the dither ("tracker" mode: the sample is not
+            fitted; see the module docstring).
 
     Returns:
         (new state, :class:`SlopeEstimate`).
     """
     s = list(state)
-    advance(s, t, z, z_dot, force, params, surface_start, saturated)
+    advance(s, t, z, z_dot, force, params, surface_start, saturated, at_force_bound)
     return s, _estimate(s)
 
 
@@ -279,6 +324,7 @@ def advance(
     params: OnlineEstimatorParams,
     surface_start: float = math.nan,
     saturated: bool = False,
+    at_force_bound: bool = False,
 ) -> None:
     """:func:`slope_step` on the state ``s`` in place, without the estimate
     (its surface is ``s[SURFACE]``)."""
@@ -296,13 +342,17 @@ def advance(
     if math.isnan(s[_T_REF]):
         s[_T_REF] = s[_T_START] = t
         s[_Z_REF] = z
-    tau = t - s[_T_REF]
-    w = math.exp(tau / p.slope_memory_s)
-    s[_G : _FF + 1] = add_sample(s[_G : _FF + 1], w, tau, s[_Z_REF] - z, -z_dot, force)
+    direct = p.slope_kappa_mode == "direct"
+    if direct or not at_force_bound:
+        tau = t - s[_T_REF]
+        w = math.exp(tau / p.slope_memory_s)
+        s[_G : _FF + 1] = add_sample(
+            s[_G : _FF + 1], w, tau, s[_Z_REF] - z, -z_dot, force
+        )
     s[_COUNT] += 1.0
     if s[_COUNT] >= SOLVE_EVERY:
-        _solve(s, t, p)
-    if p.slope_kappa_mode == "direct":
+        _solve(s, t, p, saturated)
+    if direct:
         _direct(s, z, force, dt, saturated, p)
     elif math.isfinite(s[_EPS]):
         v = s[_V_OUT]
