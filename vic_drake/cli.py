@@ -15,6 +15,7 @@ import os
 import sys
 
 from vic_drake import __version__
+from vic_drake.ctrl_c import hold_ctrl_c, release_ctrl_c
 from vic_drake.errors import VicDrakeError
 from vic_drake.malloc_tuning import reexec_tuned
 from vic_drake.paths import WITHOUT_DATA_SYNTHETIC, check_data_dir
@@ -128,21 +129,53 @@ def main(argv: list[str] | None = None) -> int:
         # Ctrl-C is caught from here on: building the parser imports the
         # commands' modules (numpy, scipy), which takes most of a second.
         return _run(argv)
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, ImportError) as exc:
+        if isinstance(exc, ImportError) and not _interrupted_import(exc):
+            raise
         print("vic-drake: interrupted", file=sys.stderr)
         if argv is None:
             # Run as the program: leave now. The run's files are closed, its
             # worker processes stopped; the interpreter's teardown of pydrake
             # would add 1-2 s (docs/decisions.md, "Output paths, data folder, Ctrl-C, run marker").
             # multiprocessing's own exit step first, so its semaphores are
-            # released (else its resource tracker warns about leaks).
+            # released (else its resource tracker warns about leaks). Its
+            # log records from here on are no news (a worker process it
+            # reaps, seen by a library's watcher thread): none is shown.
+            import logging
             import multiprocessing.util
 
+            logging.disable(logging.CRITICAL)
             multiprocessing.util._exit_function()
             sys.stdout.flush()
             sys.stderr.flush()
             os._exit(130)
         return 130
+
+
+def _import_drake_core() -> None:
+    """Imports pydrake's core with Ctrl-C held back (taken right after, as a
+    KeyboardInterrupt). A Ctrl-C inside its initialisation makes Drake log a
+    critical error with the Python stack before the ImportError; the other
+    compiled modules only raise, which :func:`main` takes as an interrupt."""
+    held = hold_ctrl_c()
+    try:
+        import pydrake.common  # noqa: F401 - the import is the point.
+    finally:
+        release_ctrl_c(held)
+
+
+def _interrupted_import(exc: ImportError) -> bool:
+    """Whether Ctrl-C caused this ImportError: a KeyboardInterrupt during a
+    compiled module's initialisation (pydrake's) comes out as "ImportError:
+    initialization failed" with the interrupt as its cause."""
+    seen = set()
+    cause = exc.__cause__ or exc.__context__
+    while cause is not None and id(cause) not in seen:
+        if isinstance(cause, KeyboardInterrupt):
+            return True
+        seen.add(id(cause))
+        cause = cause.__cause__ or cause.__context__
+    return False
 
 
 def _run(argv: list[str] | None) -> int:
@@ -152,6 +185,7 @@ def _run(argv: list[str] | None) -> int:
     args, extras = parser.parse_known_args(argv)
     if extras:
         _unknown_arguments(parser, args, extras)
+    _import_drake_core()
     try:
         # --data-dir or $VIC_DRAKE_DATA naming a folder without the data is
         # one error for every command, before any work.

@@ -262,3 +262,56 @@ def test_ctrl_c_stops_quietly_and_says_how_to_finish(tmp_path):
         time.sleep(0.1)
     else:
         pytest.fail("processes of the campaign's group are still running")
+
+
+def _group_size(pgid: int) -> int:
+    """Processes in the process group (Linux /proc)."""
+    n = 0
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                stat = Path(f"/proc/{entry}/stat").read_text()
+            except OSError:
+                continue
+            if int(stat.rsplit(")", 1)[1].split()[2]) == pgid:
+                n += 1
+    return n
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs Linux /proc")
+def test_ctrl_c_while_the_cluster_starts_leaves_nothing(tmp_path):
+    """Ctrl-C to the whole group while the worker processes start: the
+    campaign says it was interrupted, and nothing else (no worker's
+    traceback, no Dask log), leaves no process and no folder."""
+    spec = tmp_path / "spec.yaml"
+    spec.write_text(
+        f"name: early\nbase_scenario: {CAMPAIGNS / 'base' / 'short_scan_synthetic.yaml'}\n"
+        "runs: 4\nseed: 5\nduration_s: 0.6\n"
+        "factors:\n  - {field: controller, dist: grid, labels: [cs, vs-vf]}\n"
+    )
+    out = tmp_path / "out"
+    cmd = [sys.executable, "-m", "vic_drake.cli", "campaign", str(spec)]
+    proc = subprocess.Popen(
+        [*cmd, "--out", str(out), "--workers", "2"],
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
+    deadline = time.time() + 120
+    while time.time() < deadline and proc.poll() is None:
+        if _group_size(proc.pid) > 1:  # The first worker processes are up.
+            break
+        time.sleep(0.02)
+    os.killpg(proc.pid, signal.SIGINT)
+    os.killpg(proc.pid, signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, err
+    assert err == "vic-drake: interrupted\n", err
+    assert not out.exists()
+    for _ in range(100):
+        if _group_size(proc.pid) == 0:
+            break
+        time.sleep(0.1)
+    else:
+        pytest.fail("processes of the campaign's group are still running")

@@ -29,7 +29,9 @@ one twice.
 Ctrl-C stops the campaign: the local workers ignore it (the runs' own
 processes stop on it), the campaign closes the cluster with Dask's
 warnings hidden, says how many runs are kept and the command that finishes
-the rest, and raises KeyboardInterrupt.
+the rest, and raises KeyboardInterrupt. While the local cluster starts,
+Ctrl-C is held back (its worker processes start with it blocked) and taken
+once the cluster is up: the cluster is closed and nothing is written.
 """
 
 from __future__ import annotations
@@ -47,6 +49,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from vic_drake.ctrl_c import hold_ctrl_c, release_ctrl_c
 from vic_drake.errors import VicDrakeError
 from vic_drake.experiments.campaign.plan import RunPlan, plan_campaign
 from vic_drake.experiments.campaign.run import failed_row
@@ -196,16 +199,39 @@ def _client(workers: int | None, scheduler: str | None):
         raise VicDrakeError(str(exc)) from None
     from vic_drake.experiments.campaign.workers import IgnoreCtrlC
 
-    with dask.config.set({"distributed.scheduler.allowed-failures": 1}):
-        cluster = LocalCluster(
-            n_workers=n,
-            threads_per_worker=1,
-            processes=True,
-            dashboard_address=":0",  # A free port: never clash with another cluster.
-            env={"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"},
-        )
-    client = Client(cluster)
-    client.register_plugin(IgnoreCtrlC())  # Ctrl-C stops the cluster in order.
+    # Ctrl-C is held back while the cluster starts. Its threads and worker
+    # processes inherit the blocked signal, so no worker stops half started
+    # and prints its traceback. A Ctrl-C that came meanwhile is taken once
+    # the workers ignore it (the mask restored: KeyboardInterrupt), and the
+    # cluster is closed as after any Ctrl-C.
+    if hasattr(signal, "pthread_sigmask"):
+        # multiprocessing's resource tracker, started with the first worker
+        # process, unblocks SIGINT in the thread that starts it: start it now.
+        from multiprocessing import resource_tracker
+
+        resource_tracker.ensure_running()
+    held = hold_ctrl_c()
+    cluster = client = None
+    try:
+        with dask.config.set({"distributed.scheduler.allowed-failures": 1}):
+            cluster = LocalCluster(
+                n_workers=n,
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=":0",  # A free port: never clash with another.
+                env={"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"},
+            )
+        client = Client(cluster)
+        client.register_plugin(IgnoreCtrlC())  # Ctrl-C stops the cluster in order.
+        release_ctrl_c(held)
+    except BaseException:
+        with _quiet_logs(True):
+            if client is not None:
+                client.close()
+            if cluster is not None:
+                cluster.close()
+        release_ctrl_c(held)
+        raise
     return client, cluster
 
 
@@ -335,10 +361,10 @@ def _submit(
 
     from vic_drake.experiments.campaign.run import execute_run_in_child
 
-    client, cluster = _client(workers, scheduler)
     futures = {}
     interrupted = False
     with _ctrl_c_stops_once():
+        client, cluster = _client(workers, scheduler)
         try:
             _create(out, spec_text)
             n_workers = len(client.scheduler_info()["workers"])
