@@ -220,15 +220,13 @@ def test_interrupted_campaign_resumes_to_exactly_the_planned_runs(tmp_path, caps
     assert result["session_runs"] == 8 - len(before)  # The rate's runs.
 
 
-@pytest.mark.slow
-def test_ctrl_c_stops_quietly_and_says_how_to_finish(tmp_path):
-    """Ctrl-C as a terminal sends it: to the whole process group (the
-    campaign, its Dask workers, their runs' processes), and twice, as
-    ``timeout -s INT`` does."""
+def _campaign_as_a_terminal_starts_it(tmp_path, runs: int):
+    """A local campaign of short CS and VS-VF scans on 2 workers, in a
+    process group of its own as a terminal starts it: (proc, spec, out)."""
     spec = tmp_path / "spec.yaml"
     spec.write_text(
         f"name: stop\nbase_scenario: {CAMPAIGNS / 'base' / 'short_scan_synthetic.yaml'}\n"
-        "runs: 8\nseed: 5\nduration_s: 0.6\n"
+        f"runs: {runs}\nseed: 5\nduration_s: 0.6\n"
         "factors:\n  - {field: controller, dist: grid, labels: [cs, vs-vf]}\n"
     )
     out = tmp_path / "out"
@@ -239,6 +237,25 @@ def test_ctrl_c_stops_quietly_and_says_how_to_finish(tmp_path):
         text=True,
         start_new_session=True,
     )
+    return proc, spec, out
+
+
+def _wait_until_the_group_is_gone(pgid: int) -> None:
+    for _ in range(100):  # No worker nor run process is left behind.
+        try:
+            os.killpg(pgid, 0)
+        except ProcessLookupError:
+            return
+        time.sleep(0.1)
+    pytest.fail("processes of the campaign's group are still running")
+
+
+@pytest.mark.slow
+def test_ctrl_c_stops_quietly_and_says_how_to_finish(tmp_path):
+    """Ctrl-C as a terminal sends it: to the whole process group (the
+    campaign, its Dask workers, their runs' processes), and twice, as
+    ``timeout -s INT`` does."""
+    proc, spec, out = _campaign_as_a_terminal_starts_it(tmp_path, 8)
     rows_dir = out / "rows"
     deadline = time.time() + 600
     while time.time() < deadline and proc.poll() is None:
@@ -254,14 +271,7 @@ def test_ctrl_c_stops_quietly_and_says_how_to_finish(tmp_path):
     assert f"interrupted: {kept} of 8 runs done, kept in {str(out)!r}" in err
     assert f"finish the campaign with: vic-drake campaign {spec} --out {out}" in err
     assert err.rstrip().endswith("--resume\nvic-drake: interrupted"), err
-    for _ in range(100):  # No worker nor run process is left behind.
-        try:
-            os.killpg(proc.pid, 0)
-        except ProcessLookupError:
-            break
-        time.sleep(0.1)
-    else:
-        pytest.fail("processes of the campaign's group are still running")
+    _wait_until_the_group_is_gone(proc.pid)
 
 
 def _group_size(pgid: int) -> int:
@@ -284,20 +294,7 @@ def test_ctrl_c_while_the_cluster_starts_leaves_nothing(tmp_path):
     """Ctrl-C to the whole group while the worker processes start: the
     campaign says it was interrupted, and nothing else (no worker's
     traceback, no Dask log), leaves no process and no folder."""
-    spec = tmp_path / "spec.yaml"
-    spec.write_text(
-        f"name: early\nbase_scenario: {CAMPAIGNS / 'base' / 'short_scan_synthetic.yaml'}\n"
-        "runs: 4\nseed: 5\nduration_s: 0.6\n"
-        "factors:\n  - {field: controller, dist: grid, labels: [cs, vs-vf]}\n"
-    )
-    out = tmp_path / "out"
-    cmd = [sys.executable, "-m", "vic_drake.cli", "campaign", str(spec)]
-    proc = subprocess.Popen(
-        [*cmd, "--out", str(out), "--workers", "2"],
-        stderr=subprocess.PIPE,
-        text=True,
-        start_new_session=True,
-    )
+    proc, _, out = _campaign_as_a_terminal_starts_it(tmp_path, 4)
     deadline = time.time() + 120
     while time.time() < deadline and proc.poll() is None:
         if _group_size(proc.pid) > 1:  # The first worker processes are up.
@@ -309,9 +306,4 @@ def test_ctrl_c_while_the_cluster_starts_leaves_nothing(tmp_path):
     assert proc.returncode == 130, err
     assert err == "vic-drake: interrupted\n", err
     assert not out.exists()
-    for _ in range(100):
-        if _group_size(proc.pid) == 0:
-            break
-        time.sleep(0.1)
-    else:
-        pytest.fail("processes of the campaign's group are still running")
+    _wait_until_the_group_is_gone(proc.pid)
