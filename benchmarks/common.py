@@ -53,8 +53,15 @@ def checkout_environment(tree: str) -> dict[str, str]:
     """The environment ``tree``'s own processes run with: its vic_drake first on
     the path and, when the checkout has ``vic_drake/malloc_tuning.py``, its
     ``GLIBC_TUNABLES`` (what its ``vic-drake`` and campaign workers set), so a
-    checkout is measured as it runs."""
+    checkout is measured as it runs. The paper's data folder is the one this
+    process reads (``VIC_DRAKE_DATA``, else the default beside this checkout):
+    another checkout's default would be beside it, and the two would time
+    different logs."""
     env = dict(os.environ, PYTHONPATH=os.path.abspath(tree))
+    from vic_drake.paths import has_data, resolve_data_dir
+
+    if has_data():
+        env["VIC_DRAKE_DATA"] = str(resolve_data_dir())
     path = os.path.join(tree, "vic_drake", "malloc_tuning.py")
     if not os.path.isfile(path):
         return env
