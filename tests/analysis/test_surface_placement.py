@@ -87,6 +87,7 @@ def test_the_plane_is_read_back(slope, offset):
         found.offset_at(x, Y0), offset + slope * (x - X0), atol=1e-4
     )
     assert found.bins >= 15 and found.span_m > 0.15
+    assert found.start_m < 0.0 < found.start_m + found.span_m  # the origin inside
     assert 0 < found.slope_sigma_m < 1e-3 and 0 < found.offset_sigma_m < 1e-4
 
 

@@ -336,13 +336,15 @@ def test_surface_plane_raises_a_grid_by_a_plane():
         with_surface_plane(object(), 0.0, (0.0, 0.0), (0.0, 0.0))
 
 
-def _placement(offset_m=0.002, slope=0.015, span_m=0.18):
+def _placement(offset_m=0.002, slope=0.015, span_m=0.18, start_m=None):
     from vic_drake.analysis.surface_placement import SurfacePlacement
 
+    start_m = -0.5 * span_m if start_m is None else start_m
     return SurfacePlacement(
         offset_m=offset_m, slope_m_per_m=slope, offset_sigma_m=1e-4,
         slope_sigma_m=2e-3, x0_m=-0.05, y0_m=-0.355, direction=(0.8, -0.6),
-        span_m=span_m, bins=19, samples=9000, residual_rms_m=5e-4,
+        span_m=span_m, start_m=start_m, bins=19, samples=9000,
+        residual_rms_m=5e-4,
     )  # fmt: skip
 
 
@@ -361,12 +363,22 @@ def test_placed_surface_applies_the_plane_only_to_a_resting_phantom():
     # A moving phantom, a mode that does not ask for it, no plane, or a plane
     # that leaves the map's +-20 mm at an end of its span: the anchors.
     too_steep = _placement(slope=2 * calibration_max() / 0.18 + 0.01)
+    # The origin is the mean of the bin centres: with uneven bins the far
+    # end is 0.15 m from it, not 0.09 m (at 0.13 m/m: +21.5 mm there).
+    uneven = _placement(slope=0.13, start_m=-0.03)
+    assert (
+        placed_surface({**anchors, "placement": _placement(slope=0.13)}, resting=True)[
+            "source"
+        ]
+        == "placement"
+    )
     for surface, resting in (
         (anchors, False),
         ({**anchors, "placement_wanted": False}, True),
         ({**anchors, "placement": None}, True),
         ({**anchors, "placement": too_steep}, True),
         ({**anchors, "placement": _placement(offset_m=0.025)}, True),
+        ({**anchors, "placement": uneven}, True),
     ):
         assert placed_surface(surface, resting=resting) is surface
 

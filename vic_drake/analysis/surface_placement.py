@@ -59,9 +59,12 @@ class SurfacePlacement(NamedTuple):
         offset_m: surface - map at the origin, m (> 0: the map is low).
         slope_m_per_m: the surface's rise per m along ``direction``.
         offset_sigma_m, slope_sigma_m: their 1-sigma (see the module doc).
-        x0_m, y0_m: the origin (the middle of the track's bins), m.
+        x0_m, y0_m: the origin (the mean of the track's bin centres), m.
         direction: unit vector (dx, dy) along the track, dx >= 0.
         span_m: distance between the first and the last bin centre, m.
+        start_m: the first bin centre's distance from the origin along
+            ``direction``, m (<= 0; the last is at start_m + span_m; the
+            origin is the middle of the span only when the bins are even).
         bins: bins in the fit. samples: contact samples in them.
         residual_rms_m: RMS of the bins' medians about the plane, m.
     """
@@ -74,6 +77,7 @@ class SurfacePlacement(NamedTuple):
     y0_m: float
     direction: tuple[float, float]
     span_m: float
+    start_m: float
     bins: int
     samples: int
     residual_rms_m: float
@@ -234,6 +238,7 @@ def fit_surface_placement(
         y0_m=float(y0),
         direction=(float(d[0]), float(d[1])),
         span_m=float(mids.max() - mids.min()),
+        start_m=float(mids.min() - mid),
         bins=int(mids.size),
         samples=count,
         residual_rms_m=float(np.sqrt(np.mean(r**2))),

@@ -217,9 +217,10 @@ def placed_surface(surface: dict, *, resting: bool) -> dict:
 
 def _plausible_placement(placement) -> bool:
     """A plane "placement" may use: within +-MAX_SURFACE_OFFSET_M at both ends
-    of the span it was fitted on."""
-    ends = placement.offset_m + np.array([-0.5, 0.5]) * placement.span_m * (
-        placement.slope_m_per_m
+    of the span it was fitted on (first and last bin centre)."""
+    start = placement.start_m
+    ends = placement.offset_m + placement.slope_m_per_m * np.array(
+        [start, start + placement.span_m]
     )
     return bool(
         np.all(np.isfinite(ends)) and np.all(np.abs(ends) <= MAX_SURFACE_OFFSET_M)
