@@ -146,13 +146,6 @@ def MakeVariableImpedanceController(
         )
         builder.ExportOutput(est.get_estimate_output_port(), "tissue_estimate")
     qp = builder.AddNamedSystem("stiffness_qp", StiffnessQpSystem(params))
-    if reads_bounds:  # (K from state: the last tick's, no algebraic loop)
-        builder.Connect(qp.get_stiffness_output_port(), est.get_stiffness_input_port())
-        # (The estimator reads the references in its update only: no loop
-        # through its estimate, a state output.)
-        builder.Connect(
-            ref.get_references_output_port(), est.get_references_input_port()
-        )
     tank = builder.AddNamedSystem("energy_tank", EnergyTankSystem(params))
 
     # The reference system reads the three measured vectors as one, built by
@@ -196,6 +189,12 @@ def MakeVariableImpedanceController(
     )
     builder.Connect(ref.get_tick_output_port(), ref_fields.get_input_port())
     builder.Connect(ref_fields.get_output_port(0), qp_inputs.get_input_port(1))
+    if reads_bounds:
+        # K from state (the last tick's: no algebraic loop); the references
+        # through the QP's Demultiplexer (no Python output callback; read in
+        # the estimator's update only, so no loop through its estimate).
+        builder.Connect(qp.get_stiffness_output_port(), est.get_stiffness_input_port())
+        builder.Connect(ref_fields.get_output_port(0), est.get_references_input_port())
     # The QP reads T from the "tank" record through a C++ Demultiplexer: the
     # number of the tank's own "tank_energy" port, with no Python call per tick.
     tank_fields = builder.AddNamedSystem(

@@ -29,7 +29,7 @@ from vic_drake.systems.signals import (
     MEASUREMENT_SIZE,
     REF_FORCE_MIN,
     REF_FORCE_REFERENCE,
-    REFERENCES_SIZE,
+    REFERENCE_TICK_SIZE,
 )
 
 #: Where the estimator's scalars sit in the "measurement" vector: the probe
@@ -40,7 +40,7 @@ _FZ = MEASURED_FORCE.start + 2
 
 #: K_z counts as at its bound from this fraction below it.
 SATURATION_REL_TOL = 1e-3
-#: F_ref,z and F_min,z in the "references" vector.
+#: F_ref,z and F_min,z in the "references" input.
 _F_REF_Z = REF_FORCE_REFERENCE.start + 2
 _F_MIN_Z = REF_FORCE_MIN.start + 2
 
@@ -78,10 +78,11 @@ class OnlineEstimatorSystem(LeafSystem):
             ``stiffness_max_z``): the slope fit relaxes its held kappa while
             K_z is at ``stiffness_max_z``
             (:mod:`vic_drake.estimation.online.slope`).
-        references (``signals.REFERENCES_SIZE``): the force reference
-            system's "references" output (only with ``force_min_z``): the
-            slope fit's "tracker" mode leaves out the samples at which F_ref,z
-            is capped by F_min,z while F_min,z is at ``force_min_z``
+        references (``signals.REFERENCE_TICK_SIZE``): the head of the force
+            reference system's "tick" output, its "references" first, as the
+            QP reads it (only with ``force_min_z``): the slope fit's
+            "tracker" mode leaves out the samples at which F_ref,z is capped
+            by F_min,z while F_min,z is at ``force_min_z``
             (:func:`at_flat_force_bound`).
 
     Output ports (state: the last tick's estimate):
@@ -151,7 +152,7 @@ class OnlineEstimatorSystem(LeafSystem):
                     f"force_min_z must be < 0 (sensor convention); got {force_min_z!r}"
                 )
             self._references_port = self.DeclareVectorInputPort(
-                "references", REFERENCES_SIZE
+                "references", REFERENCE_TICK_SIZE
             )
             self._force_min_z = force_min_z
         self._filter = self.DeclareDiscreteState(np.asarray(state0, float))
