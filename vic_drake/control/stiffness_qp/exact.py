@@ -46,11 +46,11 @@ def solve_stiffness_qp_exact(
     """
     t0 = perf_counter()
     (e, ed, d, fr, fmn, fmx, kmn, kmx, qw, rw, a, lb_energy, lb_power) = problem
-    x0 = _axis(e[0], ed[0], d[0], fr[0], fmn[0], fmx[0], kmn[0], kmx[0], qw[0], rw[0],
+    x0 = axis_interval(e[0], ed[0], d[0], fr[0], fmn[0], fmx[0], kmn[0], kmx[0], qw[0], rw[0],
                1, feas_tol)  # fmt: skip
-    x1 = _axis(e[1], ed[1], d[1], fr[1], fmn[1], fmx[1], kmn[1], kmx[1], qw[1], rw[1],
+    x1 = axis_interval(e[1], ed[1], d[1], fr[1], fmn[1], fmx[1], kmn[1], kmx[1], qw[1], rw[1],
                1 << 4, feas_tol)  # fmt: skip
-    x2 = _axis(e[2], ed[2], d[2], fr[2], fmn[2], fmx[2], kmn[2], kmx[2], qw[2], rw[2],
+    x2 = axis_interval(e[2], ed[2], d[2], fr[2], fmn[2], fmx[2], kmn[2], kmx[2], qw[2], rw[2],
                1 << 8, feas_tol)  # fmt: skip
     if x0 is None or x1 is None or x2 is None:
         return fallback_solution(problem, t0, "infeasible")
@@ -146,13 +146,15 @@ def solve_stiffness_qp_exact(
     )
 
 
-def _axis(ei, edi, di, fri, fmin, fmax, kmin, kmax, q, r, bit, feas_tol):
+def axis_interval(ei, edi, di, fri, fmin, fmax, kmin, kmax, q, r, bit, feas_tol):
     """One axis of the QP: (lo, hi, lo_bit, hi_bit, free, curv), or None if infeasible.
 
     The bound and force rows make one interval [lo, hi]; lo_bit and hi_bit
     are the mask bits of the rows that set its ends (bit: the axis' K_min
     bit). free is the axis' unconstrained minimiser and curv = 2 (Q e^2 + R)
-    the cost's curvature d^2 cost / dk^2.
+    the cost's curvature d^2 cost / dk^2. The MathematicalProgram
+    (:mod:`~vic_drake.control.stiffness_qp.program`) builds its rows from
+    it too, so both solvers call the same ticks infeasible.
     """
     dv = di * edi
     lo, hi = kmin, kmax

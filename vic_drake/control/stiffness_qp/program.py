@@ -16,6 +16,7 @@ import numpy as np
 from vic_drake.control.stiffness_qp.constraints import active_constraints
 from vic_drake.control.stiffness_qp.exact import (
     FEASIBILITY_TOL,
+    axis_interval,
     solve_stiffness_qp_exact,
 )
 from vic_drake.control.stiffness_qp.problem import (
@@ -184,11 +185,11 @@ class StiffnessQp:
         unit = self._unit_hessian
         free = self._free
         x = _axis_rows(e[0], ed[0], d[0], fr[0], fmn[0], fmx[0], kmn[0], kmx[0],
-                       qw[0], rw[0], unit, free)  # fmt: skip
+                       qw[0], rw[0], 1, unit, free)  # fmt: skip
         y = _axis_rows(e[1], ed[1], d[1], fr[1], fmn[1], fmx[1], kmn[1], kmx[1],
-                       qw[1], rw[1], unit, free)  # fmt: skip
+                       qw[1], rw[1], 1 << 4, unit, free)  # fmt: skip
         z = _axis_rows(e[2], ed[2], d[2], fr[2], fmn[2], fmx[2], kmn[2], kmx[2],
-                       qw[2], rw[2], unit, free)  # fmt: skip
+                       qw[2], rw[2], 1 << 8, unit, free)  # fmt: skip
         if x is None or y is None or z is None:  # A force row no K of the box meets.
             return fallback_solution(problem, t0, "infeasible")
         (s0, c0, b0, lo0, hi0, flo0, fhi0) = x
@@ -247,46 +248,27 @@ class StiffnessQp:
         )
 
 
-def _axis_rows(ei, edi, di, fri, fmin, fmax, kmin, kmax, q, r, unit, free):
+def _axis_rows(ei, edi, di, fri, fmin, fmax, kmin, kmax, q, r, bit, unit, free):
     """One axis of the scaled program, or None if its force row cannot hold.
 
-    Returns (s, curv, b, lo, hi, f_lo, f_hi): the scale s (k = s kk), the
-    cost's curvature in kk (1 when ``unit``) and linear coefficient b, the
-    bounding row lo <= kk <= hi and the force row f_lo <= kk <= f_hi
-    ((-free, free) when it holds over the whole box).
+    The interval, its feasibility and the unconstrained minimiser are the
+    exact solver's (:func:`~vic_drake.control.stiffness_qp.exact.axis_interval`;
+    bit: the axis' K_min bit). Returns (s, curv, b, lo, hi, f_lo, f_hi): the
+    scale s (k = s kk), the cost's curvature in kk (1 when ``unit``) and
+    linear coefficient b, the bounding row lo <= kk <= hi and the force row
+    f_lo <= kk <= f_hi, whose side is (-)``free`` where the box is the
+    tighter bound (a force row that holds over the whole box is (-free,
+    free)).
     """
-    h = q * ei * ei + r
-    dv = di * edi
-    # cost = h k^2 - 2 (Q e (F_ref - D e_dot) + R K_min) k + const, k = s kk.
-    s = 1.0 / math.sqrt(2.0 * h) if unit else 1e3
-    b = -2.0 * (q * ei * (fri - dv) + r * kmin) * s
-    f_lo_row, f_hi_row = fmin - dv, fmax - dv
-    f_lo = ei * (kmin if ei > 0.0 else kmax)
-    f_hi = ei * (kmax if ei > 0.0 else kmin)
-    if f_lo_row <= f_lo and f_hi <= f_hi_row:  # Redundant over the box.
-        lo_f, hi_f = -free, free
-    elif ei == 0.0:  # 0 in [F_min - D e_dot, F_max - D e_dot] fails.
+    axis = axis_interval(
+        ei, edi, di, fri, fmin, fmax, kmin, kmax, q, r, bit, FEASIBILITY_TOL
+    )
+    if axis is None:
         return None
-    else:  # e s kk in [f_lo_row, f_hi_row], divided by e s.
-        c = ei * s
-        if c != 0.0:
-            lo_f, hi_f = (
-                (f_lo_row / c, f_hi_row / c)
-                if c > 0.0
-                else (f_hi_row / c, f_lo_row / c)
-            )
-        else:  # e s underflows (|e| ~ 1e-323): divide by e, then by s.
-            lo_k, hi_k = (
-                (f_lo_row / ei, f_hi_row / ei)
-                if ei > 0.0
-                else (f_hi_row / ei, f_lo_row / ei)
-            )
-            lo_f, hi_f = lo_k / s, hi_k / s
-        # A row that no K of the box meets is infeasible, as the exact oracle
-        # decides (the solver would get bounds beyond its infinity).
-        k_lo, k_hi = max(kmin, lo_f * s), min(kmax, hi_f * s)
-        if k_lo > k_hi and (
-            k_lo - k_hi > FEASIBILITY_TOL * max(1.0, abs(k_hi)) or k_hi == -math.inf
-        ):
-            return None
-    return s, 2.0 * h * s * s, b, kmin / s, kmax / s, lo_f, hi_f
+    lo, hi, lo_bit, hi_bit, k_free, curv = axis
+    # cost = (curv / 2) k^2 - curv k_free k + const, k = s kk.
+    s = 1.0 / math.sqrt(curv) if unit else 1e3
+    force_rows = (bit << 2) | (bit << 3)
+    lo_f = lo / s if lo_bit & force_rows else -free
+    hi_f = hi / s if hi_bit & force_rows else free
+    return s, curv * s * s, -curv * k_free * s, kmin / s, kmax / s, lo_f, hi_f
