@@ -8,10 +8,13 @@ import pytest
 from vic_drake.cli import main
 from vic_drake.errors import VicDrakeError
 from vic_drake.paths import (
+    CAMPAIGN_SPEC_FILE,
+    REPRODUCE_RUN_FILE,
     check_data_dir,
     check_input_file,
     check_output_dir,
     check_output_file,
+    check_run_folder,
     find_bag,
 )
 
@@ -112,3 +115,39 @@ def test_check_input_file_names_a_folder_and_an_example(tmp_path):
         check_input_file(tmp_path / "empty", "scenario file")
     with pytest.raises(VicDrakeError, match=r"does not exist \(did you mean"):
         check_input_file(tmp_path / "c.yaml", "scenario file")
+
+
+def test_a_run_folder_is_new_empty_or_its_own_kind(tmp_path):
+    new, empty = tmp_path / "new", tmp_path / "empty"
+    empty.mkdir()
+    for marker in (REPRODUCE_RUN_FILE, CAMPAIGN_SPEC_FILE):
+        assert check_run_folder(new, marker, others="x") is False
+        assert check_run_folder(empty, marker, others="x") is False
+    assert not new.exists()  # Nothing is written.
+    run, campaign = tmp_path / "run", tmp_path / "campaign"
+    for folder, marker in ((run, REPRODUCE_RUN_FILE), (campaign, CAMPAIGN_SPEC_FILE)):
+        folder.mkdir()
+        (folder / marker).write_text("")
+        assert check_run_folder(folder, marker, others="x") is True
+    # Each command's folder is named when the other command is given it.
+    with pytest.raises(
+        VicDrakeError,
+        match=r"holds a vic-drake campaign \(spec.yaml\), not a reproduce run; "
+        r"give a new or empty folder, or a previous run's folder$",
+    ):
+        check_run_folder(campaign, REPRODUCE_RUN_FILE, others="a previous run's folder")
+    with pytest.raises(
+        VicDrakeError,
+        match=r"holds a vic-drake reproduce run \(run.json\), not a campaign",
+    ):
+        check_run_folder(run, CAMPAIGN_SPEC_FILE, others="x")
+    (empty / "a").write_text("")
+    (empty / "b").mkdir()
+    for name in "cdef":
+        (empty / name).write_text("")
+    with pytest.raises(
+        VicDrakeError, match=r"holds other files \(a, b/, c, d, \.\.\.\)"
+    ):
+        check_run_folder(empty, CAMPAIGN_SPEC_FILE, others="x")
+    with pytest.raises(VicDrakeError, match="is a file; give a folder"):
+        check_run_folder(empty / "a", CAMPAIGN_SPEC_FILE, others="x")

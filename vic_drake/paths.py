@@ -21,7 +21,7 @@ DEFAULT_DATA_DIR = PROJECT_ROOT.parent / "shared" / "data"
 #: The scenario files of the paper's runs (the source of truth of reproduce).
 DIAGRAMS_DIR = PROJECT_ROOT / "diagrams"
 #: The marker file of a ``vic-drake reproduce`` run's folder (written by
-#: vic_drake.reproduce.run_dir; a campaign refuses such a folder by it).
+#: vic_drake.reproduce.run_dir; :func:`check_run_folder` names such a folder).
 REPRODUCE_RUN_FILE = "run.json"
 #: A campaign folder's spec and its folder of run scenarios (written by
 #: vic_drake.experiments.campaign.engine; scan reads a run's force limit
@@ -272,6 +272,63 @@ def check_output_dir(path: str | os.PathLike, option: str = "--out") -> Path:
             "write to"
         ) from None
     return out
+
+
+#: The run folders vic-drake writes, by their marker file: what
+#: :func:`check_run_folder` calls a folder that holds one.
+_RUN_FOLDERS = {
+    REPRODUCE_RUN_FILE: "reproduce run",
+    CAMPAIGN_SPEC_FILE: "campaign",
+}
+
+
+def check_run_folder(out: Path, marker: str, *, others: str) -> bool:
+    """Checks the ``--out`` folder of a run before any work, writing nothing.
+
+    ``out`` may be new, an empty folder, or a folder holding ``marker``
+    (one of :data:`REPRODUCE_RUN_FILE`, :data:`CAMPAIGN_SPEC_FILE`: a
+    previous run of the same command); anything else is refused, naming
+    what it holds, so a run never mixes its files into another folder.
+
+    Args:
+        out: ``--out``, resolved.
+        marker: the file that marks this command's folders.
+        others: what the refusal offers instead of a new or empty folder
+            (e.g. "a previous run's folder").
+
+    Returns:
+        Whether ``out`` holds ``marker``.
+
+    Raises:
+        VicDrakeError: ``out`` is a file, holds other files, or cannot be
+            written; or it does not exist and its parent cannot be written.
+    """
+    kind = _RUN_FOLDERS[marker]
+    if out.exists() and not out.is_dir():
+        raise VicDrakeError(
+            f"--out {str(out)!r} is a file; give a folder (it is created)"
+        )
+    own = (out / marker).is_file()
+    if not own and out.is_dir() and any(out.iterdir()):
+        raise VicDrakeError(
+            f"--out {str(out)!r} holds {_folder_contents(out)}, not a {kind}; "
+            f"give a new or empty folder, or {others}"
+        )
+    if not out.is_dir():
+        check_output_dir(out.parent, option="--out's parent folder")
+    elif not os.access(out, os.W_OK | os.X_OK):
+        raise VicDrakeError(f"--out {str(out)!r} cannot be written")
+    return own
+
+
+def _folder_contents(out: Path) -> str:
+    """What a folder that is not the asked kind of run holds."""
+    for marker, kind in _RUN_FOLDERS.items():
+        if (out / marker).is_file():
+            return f"a vic-drake {kind} ({marker})"
+    names = sorted(p.name + ("/" if p.is_dir() else "") for p in out.iterdir())
+    shown = ", ".join(names[:4]) + (", ..." if len(names) > 4 else "")
+    return f"other files ({shown})"
 
 
 def check_output_file(

@@ -39,7 +39,10 @@ def test_out_checks_before_any_work(tmp_path):
     other = tmp_path / "mine"
     other.mkdir()
     (other / "thesis.tex").write_text("x")
-    with pytest.raises(VicDrakeError, match="not a vic-drake reproduce run"):
+    with pytest.raises(
+        VicDrakeError,
+        match=r"holds other files \(thesis.tex\), not a reproduce run; give a new",
+    ):
         prepare_run_dir(other)
     afile = tmp_path / "afile"
     afile.write_text("x")

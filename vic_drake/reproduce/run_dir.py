@@ -28,7 +28,7 @@ import time
 from pathlib import Path
 
 from vic_drake.errors import VicDrakeError
-from vic_drake.paths import REPRODUCE_RUN_FILE, check_output_dir
+from vic_drake.paths import REPRODUCE_RUN_FILE, check_output_dir, check_run_folder
 
 #: The marker file of a run folder.
 RUN_FILE = REPRODUCE_RUN_FILE
@@ -158,18 +158,9 @@ def prepare_run_dir(
             ``overwrite``), or it or its parent cannot be written.
     """
     out = Path(out_dir).expanduser().resolve()
-    if out.exists() and not out.is_dir():
-        raise VicDrakeError(
-            f"--out {str(out)!r} is a file; give a folder (it is created)"
-        )
-    if out.is_dir() and any(out.iterdir()) and not _is_run_dir(out):
-        raise VicDrakeError(
-            f"--out {str(out)!r} holds files that are not a vic-drake reproduce run "
-            f"(no {RUN_FILE}); give a new or empty folder, or a previous run's folder"
-        )
+    check_run_folder(out, RUN_FILE, others="a previous run's folder")
+    # The work folder is made beside --out, whatever --out holds.
     check_output_dir(out.parent, option="--out's parent folder")
-    if out.is_dir() and not os.access(out, os.W_OK | os.X_OK):
-        raise VicDrakeError(f"--out {str(out)!r} cannot be written")
     if not overwrite:
         check_replace(out, stages=stages, data_dir=data_dir, quick=quick)
     work = work_dir_for(out)

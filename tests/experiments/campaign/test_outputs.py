@@ -64,7 +64,9 @@ def test_a_folder_of_other_files_is_refused_naming_them(tmp_path, no_cluster):
     out.mkdir()
     (out / "notes.txt").write_text("mine")
     (out / "data").mkdir()
-    with pytest.raises(VicDrakeError, match=r"holds other files \(data/, notes.txt;"):
+    with pytest.raises(
+        VicDrakeError, match=r"holds other files \(data/, notes.txt\), not a campaign;"
+    ):
         run_campaign(SMOKE, out, workers=1, resume=True)
     assert _listing(out) == ["data", "notes.txt"]
 

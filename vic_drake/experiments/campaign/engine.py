@@ -59,8 +59,7 @@ from vic_drake.malloc_tuning import allocator
 from vic_drake.paths import (
     CAMPAIGN_SCENARIOS_DIR,
     CAMPAIGN_SPEC_FILE,
-    REPRODUCE_RUN_FILE,
-    check_output_dir,
+    check_run_folder,
 )
 from vic_drake.scenario import dumps_scenario, load_scenario
 
@@ -97,10 +96,11 @@ def _check_out(
     campaign's folder; a folder holding anything else is refused, so a
     campaign never mixes its files into another run's folder.
     """
-    if out.exists() and not out.is_dir():
-        raise VicDrakeError(f"--out {str(out)!r} is a file; give a folder")
     stored = out / CAMPAIGN_SPEC_FILE
-    if stored.is_file():
+    own = check_run_folder(
+        out, CAMPAIGN_SPEC_FILE, others="(with --resume) a campaign's own folder"
+    )
+    if own:
         if not resume:
             raise VicDrakeError(
                 f"{str(out)!r} already holds a campaign; pass --resume to finish it "
@@ -110,35 +110,14 @@ def _check_out(
             raise VicDrakeError(
                 f"{str(out)!r} holds another campaign spec; --resume needs the same spec"
             )
-        if not os.access(out, os.W_OK | os.X_OK):
-            raise VicDrakeError(f"--out {str(out)!r} cannot be written")
         planned = {p.run_id for p in plans}
         return {p.stem for p in (out / "rows").glob("run_*.json")} & planned
-    if out.is_dir() and any(out.iterdir()):
-        raise VicDrakeError(
-            f"--out {str(out)!r} holds {_contents(out)}, not a campaign; give a new "
-            "or empty folder (or, with --resume, a campaign's own folder)"
-        )
-    if out.is_dir():
-        if not os.access(out, os.W_OK | os.X_OK):
-            raise VicDrakeError(f"--out {str(out)!r} cannot be written")
-    else:
-        check_output_dir(out.parent, option="--out's parent folder")
     if resume:
         # Starting is what --resume asks for in the end (every run done),
         # and nothing can be lost in a new or empty folder.
         where = "is empty" if out.is_dir() else "does not exist"
         emit(f"nothing to resume: {str(out)!r} {where}; starting the campaign")
     return set()
-
-
-def _contents(out: Path) -> str:
-    """What a folder that is not a campaign holds, for the refusal."""
-    if (out / REPRODUCE_RUN_FILE).is_file():
-        return f"a vic-drake reproduce run ({REPRODUCE_RUN_FILE})"
-    names = sorted(p.name + ("/" if p.is_dir() else "") for p in out.iterdir())
-    shown = ", ".join(names[:4]) + (", ..." if len(names) > 4 else "")
-    return f"other files ({shown}; no {CAMPAIGN_SPEC_FILE})"
 
 
 def _create(out: Path, spec_text: str) -> None:
