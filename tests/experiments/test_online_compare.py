@@ -7,15 +7,20 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from vic_drake.experiments import online_compare
 from vic_drake.experiments.online_compare import (
     COMPARISON_RUNS,
     DITHER_HZ,
     DITHER_M,
     UNDITHERED_RUNS,
     comparison_scenario,
+    comparison_table,
     main,
     online_comparison,
+    online_comparison_sweep,
+    sweep_wins,
     true_references,
+    wins_table,
 )
 from vic_drake.scenario import Scenario
 from vic_drake.tissue.phantom import GridPhantom
@@ -72,6 +77,89 @@ def test_bad_option_is_refused_before_any_scan(option, value, message, capsys):
     assert exc.value.code == 2
     err = capsys.readouterr().err
     assert option in err and message in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--dither-hz", "2.9", "60"], "--dither-hz 60.0: "),
+        (["--dither-hz", "2.9", "2.9"], "a frequency is given twice"),
+        (["--against", "wrong_map"], "unknown runs ['wrong_map']; choose from"),
+    ],
+)
+def test_a_bad_sweep_is_refused_before_any_scan(args, message, capsys, monkeypatch):
+    def no_scan(*_args, **_kwargs):
+        raise AssertionError("a scan ran")
+
+    monkeypatch.setattr(online_compare, "online_comparison", no_scan)
+    with pytest.raises(SystemExit) as exc:
+        main([str(SYNTHETIC), "true_map", *args])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert message in err and "Traceback" not in err
+
+
+def _scores(rmse, p99=9.0):
+    keys = [
+        "force_rmse_dithered_truth_N",
+        "dither_rms_N",
+        "penetration_err_mm",
+        "kappa_rel_err_median",
+        "tank_min_J",
+    ]
+    return {"force_rmse_true_N": rmse, "rib_p99_force_N": p99} | dict.fromkeys(
+        keys, 0.5
+    )
+
+
+def test_a_sweep_makes_the_dithered_runs_at_each_frequency_and_the_others_once(
+    monkeypatch,
+):
+    made = []
+
+    def fake(base, *, phantom, runs, duration_s, progress, dither_hz):
+        made.append((runs[0], dither_hz))
+        return {runs[0]: _scores(dither_hz)}
+
+    monkeypatch.setattr(online_compare, "online_comparison", fake)
+    seen = []
+    sweep = online_comparison_sweep(
+        Scenario(),
+        phantom=None,
+        runs=("online_dither_tracker", "true_map"),
+        dither_hzs=(2.9, 3.1),
+        on_scan=lambda run, hz: seen.append((run, hz)),
+    )
+    assert made == [
+        ("online_dither_tracker", 2.9),
+        ("online_dither_tracker", 3.1),
+        ("true_map", DITHER_HZ),
+    ]
+    assert seen == [
+        ("online_dither_tracker", 2.9),
+        ("online_dither_tracker", 3.1),
+        ("true_map", None),
+    ]
+    assert [s["force_rmse_true_N"] for s in sweep["online_dither_tracker"]] == [
+        2.9,
+        3.1,
+    ]
+    assert len(sweep["true_map"]) == 2  # One scan, standing at both frequencies.
+    table = comparison_table(sweep)
+    assert "| online_dither_tracker | 3.000 (2.900-3.100) |" in table
+    assert "| true_map | 3.000 | 0.500 |" in table
+
+
+def test_wins_are_counted_per_frequency_strictly_and_not_on_nan():
+    sweep = {
+        "map": [_scores(0.68, 9.6), _scores(0.68, 9.6), _scores(0.68, 9.6)],
+        "online": [_scores(0.55, 9.6), _scores(0.70, 9.5), _scores(np.nan, 9.4)],
+    }
+    wins = sweep_wins(sweep, "map")
+    assert wins == {"online": {"force_rmse_true_N": 1, "rib_p99_force_N": 2, "of": 3}}
+    table = wins_table(wins, "map", (2.9, 3.0, 3.1))
+    assert "of 3 dither frequencies (2.9, 3, 3.1 Hz)" in table
+    assert "| online | 1 of 3 | 2 of 3 |" in table
 
 
 def test_true_references_with_and_without_the_dither():
