@@ -46,12 +46,12 @@ def solve_stiffness_qp_exact(
     """
     t0 = perf_counter()
     (e, ed, d, fr, fmn, fmx, kmn, kmx, qw, rw, a, lb_energy, lb_power) = problem
-    x0 = axis_interval(e[0], ed[0], d[0], fr[0], fmn[0], fmx[0], kmn[0], kmx[0], qw[0], rw[0],
-               1, feas_tol)  # fmt: skip
-    x1 = axis_interval(e[1], ed[1], d[1], fr[1], fmn[1], fmx[1], kmn[1], kmx[1], qw[1], rw[1],
-               1 << 4, feas_tol)  # fmt: skip
-    x2 = axis_interval(e[2], ed[2], d[2], fr[2], fmn[2], fmx[2], kmn[2], kmx[2], qw[2], rw[2],
-               1 << 8, feas_tol)  # fmt: skip
+    x0 = axis_interval(e[0], ed[0], d[0], fr[0], fmn[0], fmx[0], kmn[0], kmx[0],
+                       qw[0], rw[0], 1, feas_tol)  # fmt: skip
+    x1 = axis_interval(e[1], ed[1], d[1], fr[1], fmn[1], fmx[1], kmn[1], kmx[1],
+                       qw[1], rw[1], 1 << 4, feas_tol)  # fmt: skip
+    x2 = axis_interval(e[2], ed[2], d[2], fr[2], fmn[2], fmx[2], kmn[2], kmx[2],
+                       qw[2], rw[2], 1 << 8, feas_tol)  # fmt: skip
     if x0 is None or x1 is None or x2 is None:
         return fallback_solution(problem, t0, "infeasible")
     lo0, hi0, lob0, hib0, f0, c0 = x0
