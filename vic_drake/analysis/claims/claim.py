@@ -19,6 +19,8 @@ from typing import Any
 
 import numpy as np
 
+from vic_drake.analysis.claims.thresholds import STATEMENTS
+
 #: The three verdicts of a claim (``Claim.status``, "status" in claims.json).
 PASS, FAIL, NOT_EVALUATED = "pass", "fail", "not evaluated"
 
@@ -102,7 +104,36 @@ def clean(value):
     return value
 
 
-def not_evaluated(reason_sim: str | None, reason_real: str | None) -> str:
+def two_sided(
+    claim_id: str,
+    paper: Any,
+    sim: tuple[Any, bool | None],
+    real: tuple[Any, bool | None],
+    detail: str,
+    reason_sim: str | None = None,
+    reason_real: str | None = None,
+) -> Claim:
+    """The Claim ``claim_id`` (its statement from ``thresholds.STATEMENTS``)
+    from its two sides, each (value, verdict), (None, None) for a side that
+    was not evaluated; ``detail`` says the thresholds, and a side whose
+    verdict is None adds its reason (``reason_sim``, ``reason_real``)."""
+    (sv, sp), (rv, rp) = sim, real
+    extra = _not_evaluated(
+        reason_sim if sp is None else None, reason_real if rp is None else None
+    )
+    return Claim(
+        claim_id,
+        STATEMENTS[claim_id],
+        paper,
+        clean(sv),
+        clean(rv),
+        sp,
+        rp,
+        "; ".join(p for p in (detail, extra) if p),
+    )
+
+
+def _not_evaluated(reason_sim: str | None, reason_real: str | None) -> str:
     parts = []
     if reason_sim:
         parts.append(f"sim not evaluated: {reason_sim}")

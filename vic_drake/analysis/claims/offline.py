@@ -8,14 +8,13 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import spearmanr
 
-from vic_drake.analysis.claims.claim import Claim, clean, not_evaluated
+from vic_drake.analysis.claims.claim import Claim, two_sided
 from vic_drake.analysis.claims.thresholds import (
     C2_MAX_RATIO,
     C2_MAX_SPEARMAN,
     C2_MIN_R2,
     C3_MIN_RIB_SPACING_M,
     C3_MIN_STRONG_RIBS,
-    STATEMENTS,
 )
 from vic_drake.analysis.ribs import (
     RIB_MIN_PROMINENCE,
@@ -85,18 +84,14 @@ def claim_c1(
     detail = (
         "relative RMS residuals; pass: min over beta of HC < KV and argmin beta = 1.35"
     )
-    extra = not_evaluated(
-        reason_sim if sim is None else None, reason_real if real is None else None
-    )
-    return Claim(
+    return two_sided(
         "C1",
-        STATEMENTS["C1"],
         paper_table_i(),
-        clean(sv),
-        clean(rv),
-        sp,
-        rp,
-        "; ".join(p for p in (detail, extra) if p),
+        (sv, sp),
+        (rv, rp),
+        detail,
+        reason_sim,
+        reason_real,
     )
 
 
@@ -217,18 +212,14 @@ def claim_c2(
         f"fit r(T)=c+a exp(-T/tau); pass: spearman <= {C2_MAX_SPEARMAN}, "
         f"R^2 >= {C2_MIN_R2}, a > 0, r(T_max)/r(T_min) <= {C2_MAX_RATIO} (every log)"
     )
-    extra = not_evaluated(
-        reason_sim if sim is None else None, reason_real if real is None else None
-    )
-    return Claim(
+    return two_sided(
         "C2",
-        STATEMENTS["C2"],
         "residual decreases exponentially with palpation time; 5 s chosen",
-        clean(sv),
-        clean(rv),
-        sp,
-        rp,
-        "; ".join(p for p in (detail, extra) if p),
+        (sv, sp),
+        (rv, rp),
+        detail,
+        reason_sim,
+        reason_real,
     )
 
 
@@ -260,12 +251,8 @@ def claim_c3(
         f"{C3_MIN_STRONG_RIBS} strong ribs, >= 1 weak rib, ribs >= "
         f"{C3_MIN_RIB_SPACING_M * 100:g} cm apart"
     )
-    extra = not_evaluated(
-        reason_sim if sim is None else None, reason_real if real is None else None
-    )
-    return Claim(
+    return two_sided(
         "C3",
-        STATEMENTS["C3"],
         {
             "n_ribs": 4,
             "n_strong": 3,
@@ -273,9 +260,9 @@ def claim_c3(
             "text": "4 stiff lines, 3 evident, 1 less "
             "(the rib covered by the pectoral muscle)",
         },
-        clean(sim),
-        clean(real),
-        _c3_pass(sim) if sim else None,
-        _c3_pass(real) if real else None,
-        "; ".join(p for p in (detail, extra) if p),
+        (sim, _c3_pass(sim) if sim else None),
+        (real, _c3_pass(real) if real else None),
+        detail,
+        reason_sim,
+        reason_real,
     )

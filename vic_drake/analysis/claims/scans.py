@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from vic_drake.analysis.claims.claim import Claim, clean, not_evaluated
+from vic_drake.analysis.claims.claim import Claim, clean, two_sided
 from vic_drake.analysis.claims.scan_summary import ScanLimits
 from vic_drake.analysis.claims.thresholds import (
     C4_MAX_RMSE_RATIO,
@@ -19,7 +19,6 @@ from vic_drake.analysis.claims.thresholds import (
     C7_MIN_FRACTION_AT_K_MIN,
     C7_POWER_TOL,
     C7_TANK_TOL_J,
-    STATEMENTS,
 )
 from vic_drake.control.params import ReferenceParams
 from vic_drake.paper import CONTACT_THRESHOLD_N
@@ -93,19 +92,15 @@ def claim_c4(
         f"RMSE of pressing force vs reference over the scan window; pass: ratio <= "
         f"{C4_MAX_RMSE_RATIO}, VS-CF final force < {CONTACT_THRESHOLD_N} N, CF's not"
     )
-    extra = not_evaluated(
-        reason_sim if sv is None else None, reason_real if rv is None else None
-    )
-    return Claim(
+    return two_sided(
         "C4",
-        STATEMENTS["C4"],
         "VS-CF tracks the reference force as well as force control; only "
         "VS-CF can lift off the surface",
-        clean(sv),
-        clean(rv),
-        sp,
-        rp,
-        "; ".join(p for p in (detail, extra) if p),
+        (sv, sp),
+        (rv, rp),
+        detail,
+        reason_sim,
+        reason_real,
     )
 
 
@@ -148,18 +143,14 @@ def claim_c5(
         "force range = 98th - 2nd percentile of the pressing force over the scan "
         f"window; pass: ratio >= {C5_MIN_RANGE_RATIO}"
     )
-    extra = not_evaluated(
-        reason_sim if sv is None else None, reason_real if rv is None else None
-    )
-    return Claim(
+    return two_sided(
         "C5",
-        STATEMENTS["C5"],
         "CS force strongly depends on the body's shape",
-        clean(sv),
-        clean(rv),
-        sp,
-        rp,
-        "; ".join(p for p in (detail, extra) if p),
+        (sv, sp),
+        (rv, rp),
+        detail,
+        reason_sim,
+        reason_real,
     )
 
 
@@ -246,23 +237,19 @@ def claim_c6(
         f"{C6_MAX_PEN_ERROR_M * 1e3:g} mm and p99 force on ribs <= "
         f"{1 + C6_FORCE_CAP_TOL:g} x |F_min|"
     )
-    extra = not_evaluated(
-        reason_sim if sp is None else None, reason_real if rp is None else None
-    )
-    return Claim(
+    return two_sided(
         "C6",
-        STATEMENTS["C6"],
         {
             "eps_d_m": _PAPER_REFERENCE.eps_d_m,
             "F_min_N": _PAPER_REFERENCE.force_min_z_N,
             "text": "constant penetration tracked; the minimum force avoids pushing "
             "too hard on the ribs",
         },
-        clean(sv),
-        clean(rv),
-        sp,
-        rp,
-        "; ".join(p for p in (detail, extra) if p),
+        (sv, sp),
+        (rv, rp),
+        detail,
+        reason_sim,
+        reason_real,
     )
 
 
@@ -330,17 +317,13 @@ def claim_c7(
     if rv is None and real:
         peaks = {k: v.get("peak_force_N") for k, v in real.items() if v}
         detail += f"; real peak forces without a VS-VF disturbance log: {clean(peaks)}"
-    extra = not_evaluated(
-        reason_sim if sv is None else None, reason_real if rv is None else None
-    )
-    return Claim(
+    return two_sided(
         "C7",
-        STATEMENTS["C7"],
         "stiffness decreases to its minimum until re-contact; at re-contact the "
         "valves limit its growth; the tank is not emptied",
-        clean(sv),
-        clean(rv),
-        sp,
-        rp,
-        "; ".join(p for p in (detail, extra) if p),
+        (sv, sp),
+        (rv, rp),
+        detail,
+        reason_sim,
+        reason_real,
     )
