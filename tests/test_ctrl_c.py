@@ -4,6 +4,7 @@ reading of an import that Ctrl-C cut (vic_drake.cli)."""
 import os
 import signal
 import threading
+import time
 
 import pytest
 
@@ -26,6 +27,54 @@ def test_a_held_ctrl_c_waits_for_the_release():
         with pytest.raises(KeyboardInterrupt):
             release_ctrl_c(held)
         assert signal.SIGINT not in signal.pthread_sigmask(signal.SIG_BLOCK, set())
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+@needs_masks
+def test_a_ctrl_c_that_another_thread_receives_is_held_too():
+    # The kernel gives a process's SIGINT to any thread that does not block
+    # it (a thread started before the hold, e.g. a kernel's or a pool's).
+    if threading.current_thread() is not threading.main_thread():
+        pytest.skip("signals reach the main thread only")
+    stop = threading.Event()
+    other = threading.Thread(target=stop.wait, daemon=True)
+    other.start()
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        for _ in range(5):
+            held = hold_ctrl_c()
+            os.kill(os.getpid(), signal.SIGINT)
+            deadline = time.monotonic() + 0.05
+            while time.monotonic() < deadline:  # Python runs handlers here.
+                pass
+            with pytest.raises(KeyboardInterrupt):
+                release_ctrl_c(held)
+        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    finally:
+        signal.signal(signal.SIGINT, previous)
+        stop.set()
+        other.join()
+
+
+@needs_masks
+def test_a_held_ctrl_c_goes_to_the_handler_that_was_there():
+    if threading.current_thread() is not threading.main_thread():
+        pytest.skip("signals reach the main thread only")
+    calls = []
+    previous = signal.signal(signal.SIGINT, lambda *_: calls.append("handler"))
+    try:
+        held = hold_ctrl_c()
+        signal.raise_signal(signal.SIGINT)
+        assert calls == []
+        release_ctrl_c(held)
+        assert calls == ["handler"]
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        held = hold_ctrl_c()
+        signal.raise_signal(signal.SIGINT)
+        release_ctrl_c(held)  # Ignored before the hold: ignored after it.
+        assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+        release_ctrl_c(hold_ctrl_c())  # No Ctrl-C meanwhile: nothing happens.
     finally:
         signal.signal(signal.SIGINT, previous)
 
