@@ -23,7 +23,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from common import versions
+from common import comma_list, versions
 from pydrake.common.yaml import yaml_dump_typed
 
 from vic_drake.experiments.campaign import load_campaign_spec, read_rows, run_campaign
@@ -51,13 +51,14 @@ def main() -> int:
     p.add_argument("--workers", default="1,2")
     p.add_argument("--keep", default=None, help="keep the campaign folders here")
     args = p.parse_args()
+    workers = comma_list(p, "--workers", args.workers, int)
     print(versions())
     root = Path(args.keep or tempfile.mkdtemp(prefix="bench_campaign_"))
     root.mkdir(parents=True, exist_ok=True)
     spec = _spec_with_runs(Path(args.spec), args.runs, root)
     print(f"cores: {os.cpu_count()}, python {sys.version.split()[0]}, spec {args.spec}")
     rates = {}
-    for n in (int(v) for v in args.workers.split(",")):
+    for n in workers:
         out = root / f"workers_{n}"
         shutil.rmtree(out, ignore_errors=True)
         t0 = time.perf_counter()

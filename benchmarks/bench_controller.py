@@ -49,7 +49,7 @@ import os
 import time
 
 import numpy as np
-from common import run_as_vic_drake, versions
+from common import comma_list, run_as_vic_drake, versions
 
 from vic_drake.control.params import (
     ControllerParams,
@@ -246,7 +246,7 @@ def main():
         help="function-path ticks for solvers a scenario cannot select (IPOPT: ~5 ms each)",
     )  # fmt: skip
     args = parser.parse_args()
-    solvers = [name.strip() for name in args.solvers.split(",") if name.strip()]
+    solvers = comma_list(parser, "--solvers", args.solvers)
     for name in solvers:
         if name != "exact" and name not in PROGRAM_SOLVERS:
             parser.error(

@@ -21,7 +21,13 @@ import os
 import subprocess
 import sys
 
-from common import HERE, callgrind_in_checkout, check_callgrind_baseline, versions
+from common import (
+    HERE,
+    callgrind_in_checkout,
+    check_callgrind_baseline,
+    comma_list,
+    versions,
+)
 
 
 def _worker(solver: str, warmup: int, ticks: int) -> None:
@@ -95,7 +101,7 @@ def main() -> int:
     if args.worker:
         _worker(args.worker, args.warmup, args.ticks)
         return 0
-    solvers = [name.strip() for name in args.solvers.split(",") if name.strip()]
+    solvers = comma_list(parser, "--solvers", args.solvers)
     for name in solvers:
         if name not in ("exact", "osqp", "clarabel"):
             parser.error(f"--solvers: {name!r} is not exact, osqp or clarabel")

@@ -26,6 +26,7 @@ import argparse
 from pathlib import Path
 
 import numpy as np
+from common import comma_list
 
 from vic_drake.analysis.claims.offline import c2_decay
 from vic_drake.estimation.palpation import PalpationData, compare_models, shift
@@ -110,12 +111,17 @@ def main() -> None:
     parser.add_argument("--no-trims", action="store_true")
     parser.add_argument("--settle-fractions", default=None)
     args = parser.parse_args()
+    steps = comma_list(parser, "--steps", args.steps, float)
+    fractions = (
+        comma_list(parser, "--settle-fractions", args.settle_fractions, float)
+        if args.settle_fractions
+        else None
+    )
     data_dir = resolve_data_dir(args.data_dir)
     logs = real_logs(data_dir) if has_data(data_dir) else {}
     if args.sim_dir:
         logs.update(sim_logs(Path(args.sim_dir), data_dir))
-    if args.settle_fractions:
-        fractions = [float(f) for f in args.settle_fractions.split(",")]
+    if fractions:
         for name, (data, hz) in logs.items():
             print(f"== {name} ({hz:g} Hz): settle fraction -> cycles skipped, C2")
             for f in fractions:
@@ -125,7 +131,7 @@ def main() -> None:
         "first": dict(start_step_s=None),
         "first, approach kept": dict(start_step_s=None, skip_approach=False),
     }
-    for step in (float(s) for s in args.steps.split(",")):
+    for step in steps:
         for average in ("mean", "rms", "median"):
             methods[f"{average} {step:g} s"] = dict(start_step_s=step, average=average)
     for name, (data, hz) in logs.items():

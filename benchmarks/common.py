@@ -150,6 +150,28 @@ def callgrind_in_checkout(
         return int(ticks.group(1)), dumps
 
 
+def comma_list(parser: argparse.ArgumentParser, option: str, text: str, kind=str):
+    """The comma-separated values of ``option`` as ``kind`` (str, int,
+    float); exits through ``parser.error`` naming the option and the bad
+    value, or when there is none."""
+    values = [v.strip() for v in text.split(",") if v.strip()]
+    if not values:
+        parser.error(f"{option}: give at least one value; got {text!r}")
+    try:
+        return [kind(v) for v in values]
+    except ValueError:
+        name = {int: "integers", float: "numbers"}.get(kind, "values")
+        parser.error(f"{option} takes comma-separated {name}; got {text!r}")
+
+
+def print_row(row: dict) -> None:
+    """One result as ``key=value`` pairs on a line (floats to 3 decimals)."""
+    cells = (
+        f"{k}={v:.3f}" if isinstance(v, float) else f"{k}={v}" for k, v in row.items()
+    )
+    print(" ".join(cells), flush=True)
+
+
 def data_dir_with_log(parser, data_dir, log: str):
     """The data folder holding ``experiments/<log>``; exits with a message
     when there is no data or no such log (for the benchmarks that need the

@@ -20,7 +20,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from common import data_dir_with_log, versions
+from common import comma_list, data_dir_with_log, print_row, versions
 
 from vic_drake.experiments.hand_roundtrip import MAX_EVENTS, hand_moved_roundtrip
 
@@ -37,12 +37,7 @@ def main():
         help="folder to keep the bags in, with the true and the replayed scans (pickles)",
     )
     args = parser.parse_args()
-    try:
-        seeds = [int(s) for s in args.seeds.split(",") if s.strip()]
-    except ValueError:
-        parser.error(f"--seeds takes comma-separated integers; got {args.seeds!r}")
-    if not seeds:
-        parser.error("--seeds: give at least one seed")
+    seeds = comma_list(parser, "--seeds", args.seeds, int)
     if not 1 <= args.events <= MAX_EVENTS:
         parser.error(
             f"--events takes an integer from 1 to {MAX_EVENTS}; got {args.events}"
@@ -59,11 +54,7 @@ def main():
                 data_dir, args.log, seed, args.events, out_dir, keep=keep is not None
             )
             row["wall_s"] = round(time.perf_counter() - t0, 1)
-            print(" ".join(f"{k}={_fmt(v)}" for k, v in row.items()), flush=True)
-
-
-def _fmt(v):
-    return f"{v:.3f}" if isinstance(v, float) else str(v)
+            print_row(row)
 
 
 if __name__ == "__main__":

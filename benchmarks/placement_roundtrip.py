@@ -22,19 +22,9 @@ import tempfile
 import time
 from pathlib import Path
 
-from common import data_dir_with_log, versions
+from common import comma_list, data_dir_with_log, print_row, versions
 
 from vic_drake.experiments.placement_roundtrip import placed_roundtrip
-
-
-def _floats(text: str, name: str, parser) -> list[float]:
-    try:
-        values = [float(s) for s in text.split(",") if s.strip()]
-    except ValueError:
-        parser.error(f"{name} takes comma-separated numbers; got {text!r}")
-    if not values:
-        parser.error(f"{name}: give at least one value")
-    return values
 
 
 def main():
@@ -49,8 +39,8 @@ def main():
     parser.add_argument("--data-dir", default=None)
     parser.add_argument("--keep", default=None, help="folder to keep the bags in")
     args = parser.parse_args()
-    slopes = _floats(args.slopes, "--slopes", parser)
-    modes = [m.strip() for m in args.modes.split(",") if m.strip()]
+    slopes = comma_list(parser, "--slopes", args.slopes, float)
+    modes = comma_list(parser, "--modes", args.modes)
     data_dir = data_dir_with_log(parser, args.data_dir, args.log)
     print(versions())
     with tempfile.TemporaryDirectory() as tmp:
@@ -69,12 +59,7 @@ def main():
             )
             wall = round(time.perf_counter() - t0, 1)
             for row in rows:
-                row["wall_s"] = wall
-                print(" ".join(f"{k}={_fmt(v)}" for k, v in row.items()), flush=True)
-
-
-def _fmt(v):
-    return f"{v:.3f}" if isinstance(v, float) else str(v)
+                print_row({**row, "wall_s": wall})
 
 
 if __name__ == "__main__":
