@@ -243,7 +243,7 @@ pd.DataFrame({f"{c} ({cond})": scan_metrics(df, limits=REAL_LIMITS)
         new_code_cell(
             """\
 if DATA is not None:
-    from vic_drake.experiments import compare_real
+    from vic_drake.experiments.compare_real import compare_real
     from vic_drake.reproduce.plots.scans import plot_comparison
 
     out, sim_df, real_df = compare_real(DATA / "experiments" / "test_nardi_matForce_lowR",

@@ -8,7 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from vic_drake.experiments import REAL_EXPERIMENTS, paper_scenarios, run_scan
+from vic_drake.experiments import REAL_EXPERIMENTS, run_scan
+from vic_drake.experiments.paper_scenarios import paper_scenarios
 from vic_drake.paths import has_data
 from vic_drake.scenario import (
     differences,

@@ -254,7 +254,7 @@ def _save_log(df, out: str) -> Path:
 
 def run_compare_real(args: argparse.Namespace) -> int:
     from vic_drake.analysis.real_comparison import COMPARE_REAL_KEYS
-    from vic_drake.experiments import compare_real
+    from vic_drake.experiments.compare_real import compare_real
 
     stiffness = (
         None if args.stiffness is None else _positive(args.stiffness, "--stiffness")

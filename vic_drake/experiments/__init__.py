@@ -22,115 +22,83 @@
   campaign (:func:`run_campaign`).
 - :mod:`~vic_drake.experiments.map_pipeline`: campaign, surface and GP maps,
   comparison with the truth (:func:`run_map_pipeline`).
+
+The names below are imported from their modules on first use (PEP 562):
+importing one module of the package, or the package, does not import the
+others (every experiment at once took ~2 s).
+:func:`~vic_drake.experiments.compare_real.compare_real` and
+:func:`~vic_drake.experiments.paper_scenarios.paper_scenarios` are imported
+from their modules: the package's ``compare_real`` and ``paper_scenarios``
+are those modules.
 """
 
-from vic_drake.experiments.campaign_params import CampaignParams
-from vic_drake.experiments.compare_real import compare_real
-from vic_drake.experiments.indenter_bank import IndenterBank, MakeIndenterDiagram
-from vic_drake.experiments.map_pipeline import (
-    PAPER_REGION_SIZE_M,
-    MapPipelineResult,
-    default_region,
-    run_map_pipeline,
-)
-from vic_drake.experiments.palpation_campaign import (
-    CampaignResult,
-    grid_points,
-    run_campaign,
-)
-from vic_drake.experiments.palpation_fit import PointFit, campaign_lag, fit_point
-from vic_drake.experiments.palpation_sim import SimulatedPalpation, simulate_palpations
-from vic_drake.experiments.paper_scenarios import (
-    DISTURBANCE_DELAYS_S,
-    REAL_EXPERIMENTS,
-    disturbance_lifts,
-    load_diagram,
-    paper_scenarios,
-    real_experiment_scenario,
-    scan_start_s,
-    synthetic_scenario,
-    write_paper_scenarios,
-)
-from vic_drake.experiments.real_logs import (
-    CF_FDCC_Z_GAINS,
-    CS_FDCC_Z_GAINS,
-    DEFAULT_CF_FORCE_N,
-    DEFAULT_CS_STIFFNESS_N_PER_M,
-    DEFAULT_R,
-    FZI_DEFAULT_FDCC_Z_GAINS,
-    MODEL_LOOP_GAIN_PER_KP,
-    PAPER_FDCC_Z_GAINS,
-    REAL_SCAN_FORCE_DELAY_S,
-    WAYPOINT_PERIOD_S,
-    detect_controller,
-    fit_target_profile,
-    identify_fdcc_z_gains,
-    scenario_from_real_log,
-)
-from vic_drake.experiments.scan_diagram import (
-    CommandedTipKinematics,
-    MakeScanDiagram,
-    initial_joint_positions,
-    load_scenario_phantom,
-    set_initial_state,
-)
-from vic_drake.experiments.scan_logs import (
-    LOG_GROUPS,
-    LogGroup,
-    ScanLogs,
-    logs_to_frame,
-)
-from vic_drake.experiments.scan_run import ScanResult, run_scan
+from __future__ import annotations
 
-__all__ = [
-    "CF_FDCC_Z_GAINS",
-    "CS_FDCC_Z_GAINS",
-    "DEFAULT_CF_FORCE_N",
-    "DEFAULT_CS_STIFFNESS_N_PER_M",
-    "DEFAULT_R",
-    "DISTURBANCE_DELAYS_S",
-    "FZI_DEFAULT_FDCC_Z_GAINS",
-    "LOG_GROUPS",
-    "MODEL_LOOP_GAIN_PER_KP",
-    "PAPER_FDCC_Z_GAINS",
-    "PAPER_REGION_SIZE_M",
-    "REAL_EXPERIMENTS",
-    "REAL_SCAN_FORCE_DELAY_S",
-    "WAYPOINT_PERIOD_S",
-    "CampaignParams",
-    "CampaignResult",
-    "CommandedTipKinematics",
-    "IndenterBank",
-    "LogGroup",
-    "MakeIndenterDiagram",
-    "MakeScanDiagram",
-    "MapPipelineResult",
-    "PointFit",
-    "ScanLogs",
-    "ScanResult",
-    "SimulatedPalpation",
-    "campaign_lag",
-    "compare_real",
-    "default_region",
-    "detect_controller",
-    "disturbance_lifts",
-    "fit_point",
-    "fit_target_profile",
-    "grid_points",
-    "identify_fdcc_z_gains",
-    "initial_joint_positions",
-    "load_scenario_phantom",
-    "logs_to_frame",
-    "paper_scenarios",
-    "real_experiment_scenario",
-    "run_campaign",
-    "run_map_pipeline",
-    "run_scan",
-    "scan_start_s",
-    "scenario_from_real_log",
-    "set_initial_state",
-    "simulate_palpations",
-    "synthetic_scenario",
-    "load_diagram",
-    "write_paper_scenarios",
-]
+import importlib
+
+#: Each exported name and the module of the package that defines it.
+_EXPORTS = {
+    "CampaignParams": "campaign_params",
+    "IndenterBank": "indenter_bank",
+    "MakeIndenterDiagram": "indenter_bank",
+    "PAPER_REGION_SIZE_M": "map_pipeline",
+    "MapPipelineResult": "map_pipeline",
+    "default_region": "map_pipeline",
+    "run_map_pipeline": "map_pipeline",
+    "CampaignResult": "palpation_campaign",
+    "grid_points": "palpation_campaign",
+    "run_campaign": "palpation_campaign",
+    "PointFit": "palpation_fit",
+    "campaign_lag": "palpation_fit",
+    "fit_point": "palpation_fit",
+    "SimulatedPalpation": "palpation_sim",
+    "simulate_palpations": "palpation_sim",
+    "DISTURBANCE_DELAYS_S": "paper_scenarios",
+    "REAL_EXPERIMENTS": "paper_scenarios",
+    "disturbance_lifts": "paper_scenarios",
+    "load_diagram": "paper_scenarios",
+    "real_experiment_scenario": "paper_scenarios",
+    "scan_start_s": "paper_scenarios",
+    "synthetic_scenario": "paper_scenarios",
+    "write_paper_scenarios": "paper_scenarios",
+    "CF_FDCC_Z_GAINS": "real_logs",
+    "CS_FDCC_Z_GAINS": "real_logs",
+    "DEFAULT_CF_FORCE_N": "real_logs",
+    "DEFAULT_CS_STIFFNESS_N_PER_M": "real_logs",
+    "DEFAULT_R": "real_logs",
+    "FZI_DEFAULT_FDCC_Z_GAINS": "real_logs",
+    "MODEL_LOOP_GAIN_PER_KP": "real_logs",
+    "PAPER_FDCC_Z_GAINS": "real_logs",
+    "REAL_SCAN_FORCE_DELAY_S": "real_logs",
+    "WAYPOINT_PERIOD_S": "real_logs",
+    "detect_controller": "real_logs",
+    "fit_target_profile": "real_logs",
+    "identify_fdcc_z_gains": "real_logs",
+    "scenario_from_real_log": "real_logs",
+    "CommandedTipKinematics": "scan_diagram",
+    "MakeScanDiagram": "scan_diagram",
+    "initial_joint_positions": "scan_diagram",
+    "load_scenario_phantom": "scan_diagram",
+    "set_initial_state": "scan_diagram",
+    "LOG_GROUPS": "scan_logs",
+    "LogGroup": "scan_logs",
+    "ScanLogs": "scan_logs",
+    "logs_to_frame": "scan_logs",
+    "ScanResult": "scan_run",
+    "run_scan": "scan_run",
+}
+
+__all__ = list(_EXPORTS)
+
+
+def __getattr__(name: str):
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"{__name__}.{module}"), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

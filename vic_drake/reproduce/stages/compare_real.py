@@ -15,7 +15,7 @@ from vic_drake.reproduce.workers import worker_pool
 def _compare_real_job(args):
     """Worker: one real experiment re-run in simulation (module-level for spawn)."""
     # Function-local: pydrake (heavy).
-    from vic_drake.experiments import compare_real
+    from vic_drake.experiments.compare_real import compare_real
 
     bag, data_dir, relaxation = args
     return compare_real(
