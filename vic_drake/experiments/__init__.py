@@ -34,7 +34,7 @@ are those modules.
 
 from __future__ import annotations
 
-import importlib
+from vic_drake.lazy_exports import lazy_exports
 
 #: Each exported name and the module of the package that defines it.
 _EXPORTS = {
@@ -91,14 +91,6 @@ _EXPORTS = {
 __all__ = list(_EXPORTS)
 
 
-def __getattr__(name: str):
-    module = _EXPORTS.get(name)
-    if module is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(f"{__name__}.{module}"), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_exports(
+    globals(), {name: f"{__name__}.{module}" for name, module in _EXPORTS.items()}
+)
