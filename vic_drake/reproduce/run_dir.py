@@ -159,8 +159,9 @@ def prepare_run_dir(
     """
     out = Path(out_dir).expanduser().resolve()
     check_run_folder(out, RUN_FILE, others="a previous run's folder")
-    # The work folder is made beside --out, whatever --out holds.
-    check_output_dir(out.parent, option="--out's parent folder")
+    if out.is_dir():  # (A new --out's parent is checked above.) The work
+        # folder is made beside --out, whatever --out holds.
+        check_output_dir(out.parent, option="--out's parent folder")
     if not overwrite:
         check_replace(out, stages=stages, data_dir=data_dir, quick=quick)
     work = work_dir_for(out)
