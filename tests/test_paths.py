@@ -45,7 +45,11 @@ def test_output_paths_checked_before_simulating(tmp_path, monkeypatch, capsys):
         raise AssertionError("simulated before checking the output path")
 
     monkeypatch.setattr(experiments, "run_scan", no_simulation)
-    monkeypatch.setattr(experiments, "compare_real", no_simulation)
+    # (The package's compare_real is its module; the command imports the
+    # function from there.)
+    monkeypatch.setattr(
+        "vic_drake.experiments.compare_real.compare_real", no_simulation
+    )
     afile = tmp_path / "afile"
     afile.write_text("x")
     scenario = "diagrams/nominal_vs_vf_synthetic.yaml"
