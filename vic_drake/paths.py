@@ -10,6 +10,7 @@ The real data is never copied into this repository. It is found, in order:
 
 from __future__ import annotations
 
+import difflib
 import os
 from pathlib import Path
 
@@ -33,6 +34,35 @@ CAMPAIGN_SCENARIOS_DIR = "scenarios"
 def diagram_names() -> list[str]:
     """The shipped scenarios: the stems of ``diagrams/*.yaml``, sorted."""
     return sorted(p.stem for p in DIAGRAMS_DIR.glob("*.yaml"))
+
+
+def scenario_path(text: str, say=None) -> Path:
+    """The scenario file ``text`` names.
+
+    A bare name that is not a file here (``nominal_vs_vf_synthetic``, with
+    or without ``.yaml``) names the shipped ``diagrams/<name>.yaml`` when
+    there is one (``say`` reports it), else the error names the closest
+    shipped ones. Anything else is returned as given; load_scenario says
+    when it is a folder or missing.
+    """
+    path = Path(text).expanduser()
+    if path.exists() or len(path.parts) != 1:
+        return path
+    stem = path.stem if path.suffix in (".yaml", ".yml") else path.name
+    shipped = DIAGRAMS_DIR / f"{stem}.yaml"
+    if shipped.is_file():
+        if say is not None:
+            say(f"scenario {text!r}: the shipped {shipped}")
+        return shipped
+    near = difflib.get_close_matches(stem, diagram_names(), n=3, cutoff=0.6)
+    hint = (
+        "; did you mean " + ", ".join(f"diagrams/{n}.yaml" for n in near) + "?"
+        if near
+        else f"; the shipped scenarios are in {str(DIAGRAMS_DIR)!r}"
+    )
+    raise VicDrakeError(
+        f"scenario file {text!r} does not exist here nor as diagrams/{stem}.yaml{hint}"
+    )
 
 
 def resolve_data_dir(data_dir: str | os.PathLike | None = None) -> Path:

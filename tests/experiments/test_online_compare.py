@@ -17,9 +17,11 @@ from vic_drake.experiments.online_compare import (
     comparison_table,
     main,
     online_comparison,
+    true_references,
+)
+from vic_drake.experiments.online_sweep import (
     online_comparison_sweep,
     sweep_wins,
-    true_references,
     wins_table,
 )
 from vic_drake.scenario import Scenario
@@ -83,7 +85,7 @@ def test_bad_option_is_refused_before_any_scan(option, value, message, capsys):
     "args, message",
     [
         (["--dither-hz", "2.9", "60"], "--dither-hz 60.0: "),
-        (["--dither-hz", "2.9", "2.9"], "a frequency is given twice"),
+        (["--dither-hz", "2.9", "2.9"], "--dither-hz 2.9 2.9: 2.9 Hz given twice"),
         (["--against", "wrong_map"], "unknown runs ['wrong_map']; choose from"),
     ],
 )

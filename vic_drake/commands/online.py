@@ -1,11 +1,20 @@
-"""``vic-drake estimate-online BAG``: an online estimator replayed over a real log.
+"""``vic-drake estimate-online BAG``: an online estimator replayed over a
+real log; ``vic-drake compare-online SCENARIO``: the closed loop on the
+online estimates against the true and the wrong maps.
 
-Runs the recursive least squares or the EKF tick by tick over a palpation
-log (6 columns; reference: the offline least-squares Hunt-Crossley fit of
-the whole log) or a variable-impedance scan log (31 columns; reference: the
-measured GP map's kappa and lambda at the probe's (x, y)), and prints the
-median relative errors, the correlation of kappa with the reference, the
-convergence time and the tick cost.
+``estimate-online`` runs the recursive least squares or the EKF tick by
+tick over a palpation log (6 columns; reference: the offline least-squares
+Hunt-Crossley fit of the whole log) or a variable-impedance scan log (31
+columns; reference: the measured GP map's kappa and lambda at the probe's
+(x, y)), and prints the median relative errors, the correlation of kappa
+with the reference, the convergence time and the tick cost.
+
+``compare-online`` simulates the scenario's VS-VF scan on the true map, on
+wrong maps (kappa x 1.3 or x 0.7, surface 2 mm high) and on the online
+estimates, at one or several dither frequencies, and scores each run
+against the TRUE tissue: force RMSE, p99 force over the ribs, kappa error,
+tank minimum. With several frequencies each cell is the mean (min-max);
+``--against RUN`` counts the frequencies at which each run is below RUN.
 """
 
 from __future__ import annotations
@@ -23,6 +32,7 @@ from vic_drake.commands.common import (
     help_text,
 )
 from vic_drake.errors import VicDrakeError
+from vic_drake.experiments.online_sweep import add_comparison_arguments
 
 
 def _estimate_online(args: argparse.Namespace) -> int:
@@ -95,8 +105,35 @@ def _convergence_line(convergence_s) -> str:
     )
 
 
+def _compare_online(args: argparse.Namespace) -> int:
+    from vic_drake.experiments.online_sweep import (
+        comparison_report,
+        online_comparison_sweep,
+        prepare_comparison,
+        scan_progress,
+        sweep_json,
+    )
+
+    say = Progress()
+    base, runs, phantom = prepare_comparison(args, say)
+    sweep = online_comparison_sweep(
+        base,
+        phantom=phantom,
+        runs=runs,
+        dither_hzs=args.dither_hz,
+        duration_s=args.duration,
+        on_scan=scan_progress(runs, args.dither_hz, say),
+    )
+    emit(
+        sweep_json(sweep, args.dither_hz, args.against),
+        args.json,
+        comparison_report(sweep, args.dither_hz, args.against),
+    )
+    return 0
+
+
 def register(subparsers) -> None:
-    """Adds ``estimate-online``."""
+    """Adds ``estimate-online`` and ``compare-online``."""
     p = subparsers.add_parser(
         "estimate-online",
         help="replay an online kappa/lambda estimator over a real log",
@@ -139,3 +176,13 @@ def register(subparsers) -> None:
     add_bag_data_dir_option(p)
     add_json_option(p)
     p.set_defaults(handler=_estimate_online)
+
+    q = subparsers.add_parser(
+        "compare-online",
+        help="VS-VF on the true map, wrong maps and online estimates, scored "
+        "against the true tissue",
+        description=help_text(__doc__, 2),
+    )
+    add_comparison_arguments(q)
+    add_json_option(q)
+    q.set_defaults(handler=_compare_online)

@@ -12,7 +12,6 @@ the campaign reported.
 
 from __future__ import annotations
 
-import difflib
 import math
 from pathlib import Path
 
@@ -21,8 +20,6 @@ from vic_drake.errors import VicDrakeError
 from vic_drake.paths import (
     CAMPAIGN_SCENARIOS_DIR,
     CAMPAIGN_SPEC_FILE,
-    DIAGRAMS_DIR,
-    diagram_names,
 )
 
 SCAN_DESCRIPTION = (
@@ -41,35 +38,6 @@ SCAN_DESCRIPTION = (
 #: How far past a scenario's full run --duration may reach, s (the probe
 #: only holds still after its trajectory's end).
 MAX_EXTRA_DURATION_S = 60.0
-
-
-def scenario_path(text: str, say=None) -> Path:
-    """The scenario file ``text`` names.
-
-    A bare name that is not a file here (``nominal_vs_vf_synthetic``, with
-    or without ``.yaml``) names the shipped ``diagrams/<name>.yaml`` when
-    there is one (``say`` reports it), else the error names the closest
-    shipped ones. Anything else is returned as given; load_scenario says
-    when it is a folder or missing.
-    """
-    path = Path(text).expanduser()
-    if path.exists() or len(path.parts) != 1:
-        return path
-    stem = path.stem if path.suffix in (".yaml", ".yml") else path.name
-    shipped = DIAGRAMS_DIR / f"{stem}.yaml"
-    if shipped.is_file():
-        if say is not None:
-            say(f"scenario {text!r}: the shipped {shipped}")
-        return shipped
-    near = difflib.get_close_matches(stem, diagram_names(), n=3, cutoff=0.6)
-    hint = (
-        "; did you mean " + ", ".join(f"diagrams/{n}.yaml" for n in near) + "?"
-        if near
-        else f"; the shipped scenarios are in {str(DIAGRAMS_DIR)!r}"
-    )
-    raise VicDrakeError(
-        f"scenario file {text!r} does not exist here nor as diagrams/{stem}.yaml{hint}"
-    )
 
 
 def check_scan_duration(scenario, duration_s: float) -> None:
@@ -230,5 +198,4 @@ __all__ = [
     "check_scan_duration",
     "scan_human_summary",
     "scan_metrics_dict",
-    "scenario_path",
 ]

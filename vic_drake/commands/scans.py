@@ -29,10 +29,9 @@ from vic_drake.commands.scan_summary import (
     check_scan_duration,
     scan_human_summary,
     scan_metrics_dict,
-    scenario_path,
 )
 from vic_drake.errors import VicDrakeError
-from vic_drake.paths import PLOT_SUFFIXES, check_output_file
+from vic_drake.paths import PLOT_SUFFIXES, check_output_file, scenario_path
 
 
 def _positive(value: str, option: str) -> float:

@@ -26,11 +26,12 @@ well):
 -9 N binds on the ribs in every run, so their p99 force there is the
 bound's; docs/decisions.md, "The closed loop at the QP's own force bound").
 Given several ``--dither-hz``, the dithered runs are made at each
-(:func:`online_comparison_sweep`): a closed loop with an estimator in it
-moves by 0.1-0.2 N of force RMSE from one dither frequency to the next, so
-one run's margin over another is no evidence; the table then shows each
-score's mean and range, and ``--against RUN`` counts the frequencies at
-which each run is below RUN (:func:`sweep_wins`).
+(:mod:`vic_drake.experiments.online_sweep`; the same command is ``vic-drake
+compare-online``): a closed loop with an estimator in it moves by 0.1-0.2 N
+of force RMSE from one dither frequency to the next, so one run's margin
+over another is no evidence; the table then shows each score's mean and
+range, and ``--against RUN`` counts the frequencies at which each run is
+below RUN.
 
 Scores over the scan window (:func:`vic_drake.analysis.contact.scan_window`):
 
@@ -68,7 +69,6 @@ import numpy as np
 
 from vic_drake.analysis.contact import pressing_force_N, scan_window
 from vic_drake.analysis.scan_metrics import RIB_KAPPA_THRESHOLD, force_rmse_N
-from vic_drake.errors import VicDrakeError
 from vic_drake.experiments.scan_run import run_scan
 from vic_drake.scenario import Scenario
 
@@ -242,43 +242,6 @@ def online_comparison(
     return out
 
 
-def online_comparison_sweep(
-    base: Scenario,
-    *,
-    phantom,
-    runs=UNDITHERED_RUNS,
-    dither_hzs=(DITHER_HZ,),
-    duration_s=None,
-    progress=None,
-    on_scan=None,
-) -> dict[str, list[dict]]:
-    """{run: [scores at each of ``dither_hzs``]}: each dithered run made at
-    every frequency; a run without the dither (which the frequency does not
-    touch) made once, its scores standing at every frequency.
-
-    ``on_scan(run, hz)`` (optional) is called before each scan (hz None for
-    a run without the dither).
-    """
-    out = {}
-    for run in runs:
-        hzs = tuple(dither_hzs) if COMPARISON_RUNS[run].dither else (None,)
-        scores = []
-        for hz in hzs:
-            if on_scan is not None:
-                on_scan(run, hz)
-            one = online_comparison(
-                base,
-                phantom=phantom,
-                runs=(run,),
-                duration_s=duration_s,
-                progress=progress,
-                dither_hz=DITHER_HZ if hz is None else hz,
-            )
-            scores.append(one[run])
-        out[run] = scores * len(dither_hzs) if hzs == (None,) else scores
-    return out
-
-
 #: The table's scores: (key, column title, decimals).
 _COLUMNS = (
     ("force_rmse_true_N", "force RMSE vs truth N", 3),
@@ -289,13 +252,12 @@ _COLUMNS = (
     ("rib_p99_force_N", "p99 force on ribs N", 2),
     ("tank_min_J", "tank min J", 3),
 )
-#: The scores :func:`sweep_wins` compares (lower is better).
-WIN_SCORES = ("force_rmse_true_N", "rib_p99_force_N")
 
 
 def comparison_table(scores: dict) -> str:
     """The scores as a markdown table, one row a run: ``{run: scores}``, or
-    ``{run: [scores, ...]}`` from :func:`online_comparison_sweep`, whose
+    ``{run: [scores, ...]}`` from
+    :func:`vic_drake.experiments.online_sweep.online_comparison_sweep`, whose
     cells are "mean (min-max)" over the frequencies (the mean alone where
     they agree to the digits shown)."""
     lines = [
@@ -316,141 +278,13 @@ def comparison_table(scores: dict) -> str:
     return "\n".join(lines)
 
 
-def sweep_wins(sweep: dict[str, list[dict]], against: str) -> dict[str, dict]:
-    """For each run but ``against``: {score: at how many frequencies the run
-    is strictly below ``against``} for :data:`WIN_SCORES` (a NaN on either
-    side is not a win), and "of": the number of frequencies."""
-    reference = sweep[against]
-    wins = {}
-    for run, scores in sweep.items():
-        if run == against:
-            continue
-        row = {
-            key: sum(
-                bool(mine[key] < ref[key])
-                for mine, ref in zip(scores, reference, strict=True)
-            )
-            for key in WIN_SCORES
-        }
-        row["of"] = len(reference)
-        wins[run] = row
-    return wins
-
-
-def wins_table(wins: dict[str, dict], against: str, dither_hzs) -> str:
-    """:func:`sweep_wins` as a markdown table."""
-    hz = ", ".join(f"{f:g}" for f in dither_hzs)
-    lines = [
-        f"Below {against} (lower is better), of {len(dither_hzs)} dither "
-        f"frequencies ({hz} Hz):",
-        "",
-        "| run | force RMSE vs truth | p99 force on ribs |",
-        "|---|---|---|",
-    ]
-    for run, row in wins.items():
-        lines.append(
-            f"| {run} | {row['force_rmse_true_N']} of {row['of']} | "
-            f"{row['rib_p99_force_N']} of {row['of']} |"
-        )
-    return "\n".join(lines)
-
-
 def main(argv=None) -> None:
-    """``python -m vic_drake.experiments.online_compare SCENARIO [RUN ...]
-    [--dither-hz HZ [HZ ...]] [--force-min-z N] [--against RUN]``: prints
-    the table (every run of :data:`COMPARISON_RUNS` by default; the
-    dithered runs at each HZ, default :data:`DITHER_HZ`; VS-VF's F_min,z at
-    N, default the scenario's) and, with ``--against``, at how many
-    frequencies each run is below RUN."""
-    import argparse
-    import sys
-    import time
+    """``python -m vic_drake.experiments.online_compare``: the comparison's
+    command line (:func:`vic_drake.experiments.online_sweep.main`; also
+    ``vic-drake compare-online``)."""
+    from vic_drake.experiments.online_sweep import main as sweep_main
 
-    from vic_drake.experiments.scan_diagram import load_scenario_phantom
-    from vic_drake.scenario import load_scenario
-
-    parser = argparse.ArgumentParser(description=main.__doc__)
-    parser.add_argument("scenario", help="a VS-VF scenario YAML")
-    parser.add_argument("runs", nargs="*", help="runs to make (default: all)")
-    parser.add_argument(
-        "--dither-hz",
-        type=float,
-        nargs="+",
-        default=[DITHER_HZ],
-        metavar="HZ",
-        help="frequencies of the dithered runs' dither, Hz: each dithered run is "
-        f"made at each (default {DITHER_HZ})",
-    )
-    parser.add_argument(
-        "--force-min-z",
-        type=float,
-        default=None,
-        metavar="N",
-        help="VS-VF's F_min,z of every run, N (sensor convention, < 0; default: "
-        "the scenario's)",
-    )
-    parser.add_argument(
-        "--against",
-        default=None,
-        metavar="RUN",
-        help="also count, per run, the frequencies at which its force RMSE and "
-        "its p99 force on the ribs are below RUN's (RUN is made if not listed)",
-    )
-    args = parser.parse_args(argv)
-    unknown = [r for r in args.runs if r not in COMPARISON_RUNS]
-    if args.against is not None and args.against not in COMPARISON_RUNS:
-        unknown.append(args.against)
-    if unknown:
-        parser.error(f"unknown runs {unknown}; choose from {list(COMPARISON_RUNS)}")
-    if len(set(args.dither_hz)) != len(args.dither_hz):
-        parser.error(f"--dither-hz {args.dither_hz}: a frequency is given twice")
-    base = load_scenario(args.scenario)
-    if args.force_min_z is not None:
-        base.controller.reference.force_min_z_N = args.force_min_z
-        try:
-            base = base.validate()
-        except VicDrakeError as exc:
-            parser.error(f"--force-min-z {args.force_min_z!r}: {exc}")
-    runs = tuple(args.runs) or tuple(COMPARISON_RUNS)
-    if args.against is not None and args.against not in runs:
-        runs += (args.against,)
-    for hz in args.dither_hz:  # Every frequency (even if no run is dithered)
-        try:  # is checked before a scan.
-            comparison_scenario(base, "online_dither", dither_hz=hz)
-        except VicDrakeError as exc:
-            parser.error(f"--dither-hz {hz!r}: {exc}")
-    total = sum(len(args.dither_hz) if COMPARISON_RUNS[r].dither else 1 for r in runs)
-    t0, made = time.perf_counter(), 0
-
-    def on_scan(run, hz):
-        nonlocal made
-        made += 1
-        if total > 1:
-            at = "" if hz is None else f" at {hz:g} Hz"
-            elapsed = time.perf_counter() - t0
-            print(
-                f"scan {made} of {total}: {run}{at} ({elapsed:.0f} s so far)",
-                file=sys.stderr,
-                flush=True,
-            )
-
-    sweep = online_comparison_sweep(
-        base,
-        phantom=load_scenario_phantom(base),
-        runs=runs,
-        dither_hzs=args.dither_hz,
-        on_scan=on_scan,
-    )
-    if len(args.dither_hz) == 1:
-        print(comparison_table({run: scores[0] for run, scores in sweep.items()}))
-    else:
-        hz = ", ".join(f"{f:g}" for f in args.dither_hz)
-        print(f"Mean (min-max) over the dither frequencies {hz} Hz:\n")
-        print(comparison_table(sweep))
-    if args.against is not None:
-        print()
-        wins = sweep_wins(sweep, args.against)
-        print(wins_table(wins, args.against, args.dither_hz))
+    sweep_main(argv)
 
 
 __all__ = [
@@ -459,17 +293,13 @@ __all__ = [
     "DITHER_HZ",
     "DITHER_M",
     "UNDITHERED_RUNS",
-    "WIN_SCORES",
     "comparison_scenario",
     "comparison_table",
     "desired_penetrations",
     "main",
     "online_comparison",
-    "online_comparison_sweep",
     "score_against_truth",
-    "sweep_wins",
     "true_references",
-    "wins_table",
 ]
 
 if __name__ == "__main__":
