@@ -352,14 +352,15 @@ ax.set_xlabel("t [s]"); ax.set_ylabel("kappa"); ax.legend()"""
             "With the rig's F_min,z of -9 N the force over the ribs sits at that "
             "bound in every run, so the p99 force there is the bound's. The second "
             "table sets F_min,z to the QP's own -15 N: the ribs' force is then the "
-            "controller's choice: there the tracker wins and the direct mode "
-            "loses, its saturation rule over-reading kappa while the tip rides up "
-            "a rib (docs/decisions.md, \"The closed loop at the QP's own force "
-            'bound"). At -9 N both modes beat the +30 % map on this phantom. '
+            "controller's choice, and both modes press them with less force than "
+            "the +30 % map and follow the tissue closer. At -9 N the tracker beats "
+            "that map on this phantom; the direct mode's held kappa lags the "
+            "ribs' rise, and over five dither frequencies it is below the map at "
+            'three (docs/decisions.md, "One saturation rule for both modes"). '
             "The tracker leaves out of its fit the samples where the force sits "
-            "at F_min,z, and lets a held kappa fall while K_z is at K_max "
-            '(docs/decisions.md, "The tracker at the controller\'s bounds"). '
-            "Shortened in the test suite's short mode."
+            "at F_min,z, and in both modes a held kappa may only fall while K_z "
+            "is at K_max (docs/decisions.md, \"The tracker at the controller's "
+            "bounds\"). Shortened in the test suite's short mode."
         ),
         new_code_cell(
             """\

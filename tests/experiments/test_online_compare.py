@@ -212,8 +212,8 @@ def test_dither_makes_the_map_free_controller_press_like_the_true_map():
     # 9 s: 5.5 s of scanning over the first rib of the synthetic chest.
     base, scores = short_comparison(("online", "online_dither"), 9.0)
     plain, dithered = scores["online"], scores["online_dither"]
-    # Measured: 1.75 -> 0.41 N vs the true reference, the
-    # dither's own swing included; penetration error 1.36 -> 0.53 mm (the
+    # Measured: 1.75 -> 0.51 N vs the true reference, the
+    # dither's own swing included; penetration error 1.36 -> 0.66 mm (the
     # slope fit's "direct" mode; its "tracker" mode gave 0.40 N, 0.52 mm).
     assert dithered["force_rmse_true_N"] < 0.5 * plain["force_rmse_true_N"]
     assert dithered["penetration_err_mm"] < 0.5 * plain["penetration_err_mm"]
@@ -227,9 +227,9 @@ def test_tracker_beats_the_over_estimating_map_where_the_bound_does_not_cap():
         ("wrong_map_+30_dither", "online_dither_tracker"), 12.0, force_min_z_N=-15.0
     )
     wrong, online = scores["wrong_map_+30_dither"], scores["online_dither_tracker"]
-    # Measured when written: 0.92 N against 1.74 N (the direct mode's
-    # saturation rule runs away here: 3.19 N; docs/decisions.md, "The closed
-    # loop at the QP's own force bound").
+    # Measured when written: 0.92 N against 1.74 N (the direct mode: 3.19 N
+    # with its old saturation rule, which ran away here; 1.06 N with the
+    # tracker's; docs/decisions.md, "One saturation rule for both modes").
     assert online["force_rmse_true_N"] < 0.7 * wrong["force_rmse_true_N"]
     assert online["tank_min_J"] >= base.controller.tank.min_energy_J
     # The kappa the references were made with: the map's x 1.3, and an

@@ -17,7 +17,7 @@ well):
   surface from the tissue's slope under the dithered tip
   (``online_estimator.surface_from_slope``, no EKF surface state) in the
   fit's "direct" mode (``slope_kappa_mode``: kappa from the fit, held,
-  relaxed towards the force while K_z is saturated);
+  softened towards the force at the held surface while K_z is saturated);
   "online_dither_tracker" is the same in the fit's "tracker" mode (the
   estimator's default: the fit's surface through a slow filter). The map
   runs with the dither show what the dither alone costs.

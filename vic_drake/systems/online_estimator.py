@@ -75,7 +75,7 @@ class OnlineEstimatorSystem(LeafSystem):
             surface state is on), or, with ``surface_map`` (a Phantom), read
             from the map under the probe.
         stiffness (3): the controller's stiffness K, N/m (only with
-            ``stiffness_max_z``): the slope fit relaxes its held kappa while
+            ``stiffness_max_z``): the slope fit softens its held kappa while
             K_z is at ``stiffness_max_z``
             (:mod:`vic_drake.estimation.online.slope`).
         references (``signals.REFERENCE_TICK_SIZE``): the head of the force

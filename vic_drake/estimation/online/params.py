@@ -101,9 +101,9 @@ class OnlineEstimatorParams:
             fit's surface (1 / its natural frequency), s ("tracker" mode).
         slope_kappa_mode: "tracker" (the fit's surface through a slow
             filter; kappa follows the force) or "direct" (kappa from the
-            fit's valid solves, held between them, relaxed towards the
-            force at the held surface while the stiffness is saturated;
-            the surface z + (F / kappa)^(1 / beta)); see
+            fit's valid solves, held between them; the surface z + (F /
+            kappa)^(1 / beta)); in both, a saturated stiffness softens a
+            held kappa towards the force at the held surface; see
             :mod:`~vic_drake.estimation.online.slope` and, for where each
             wins, docs/decisions.md ("The tracker at the controller's
             bounds").

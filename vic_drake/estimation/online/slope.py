@@ -42,46 +42,36 @@ restarts at each loss of contact.
 
 That is the "tracker" mode (``slope_kappa_mode``): the surface is smooth
 and kappa follows the force. Two flags from the controller's side change
-it at the controller's bounds (docs/decisions.md, "The tracker at the
-controller's bounds"):
+the fit at the controller's bounds (docs/decisions.md, "The tracker at
+the controller's bounds"):
 
-- a sample taken while the controller holds the force at a bound that
-  does not follow the dither (``at_force_bound``: VS-VF's F_min,z in the
-  dither's upper half-cycle) is not fitted. Its force is the controller's
-  choice, not the tissue's answer to the tip's motion, and such samples
-  read the slope low on the ribs;
-- while the stiffness is at its bound (``saturated``), a solve that is
-  not valid moves the held kappa down towards ``F / (s_hold - z)^beta``
-  where that reading is the softer one (F and z the solve's mean force
-  and tip height: read from each sample, the force's noise would ratchet
-  kappa down). s_hold is the last valid solve's own surface (mean z + eps
-  at its mean time: its mean force, free of the dither's damping force).
-  A kappa held too high asks more force than the saturated stiffness
-  gives, the tip stops, and no solve is valid again: the held surface is
-  then the only reading of a tissue that softens.
+- in the "tracker" mode, a sample taken while the controller holds the
+  force at a bound that does not follow the dither (``at_force_bound``:
+  VS-VF's F_min,z in the dither's upper half-cycle) is not fitted. Its
+  force is the controller's choice, not the tissue's answer to the tip's
+  motion, and such samples read the slope low on the ribs;
+- in both modes, while the stiffness is at its bound (``saturated``), a
+  solve that is not valid moves the held kappa down towards ``F / (s_hold
+  - z)^beta`` where that reading is the softer one (F and z the solve's
+  mean force and tip height: read from each sample, the force's noise
+  would ratchet kappa down). s_hold is the last valid solve's own surface
+  (mean z + eps at its mean time: its mean force, free of the dither's
+  damping force). A kappa held too high asks more force than the saturated
+  stiffness gives, the tip stops, and no solve is valid again: the held
+  surface is then the only reading of a tissue that softens. A saturated
+  stiffness never stiffens the held kappa: a tip that rides up a rib under
+  it reads as a stiffer tissue at the held surface, and a higher kappa
+  keeps the stiffness saturated, a loop with no bound where F_min,z does
+  not cap the reference (docs/decisions.md, "One saturation rule for both
+  modes").
 
-The "direct" mode holds kappa instead (and fits every sample):
-ln kappa follows the valid solves' F / eps^beta, is held while the solves
-are not valid, and the output surface is ``z + (F / kappa)^(1 / beta)``
-(the EKF downstream then reads that kappa back). A held kappa is a trap
-where the stiffness saturates: the tip stops, no solve is valid again and
-kappa stays where it was while the tissue changes. So while the caller
-says the stiffness is at its bound (``saturated``) and the last solve is
-not valid, ln kappa moves towards ``F / (s_hold - z)^beta`` (s_hold as
-above; F and z this sample's), up or down. Where the tip has
-risen above the depth of that solve, the held surface would read the
-rise as a stiffer tissue, while a surface rising under the tip (a rib)
-explains it as well; the rule then takes the softer of the two readings,
-the depth held: ``F / max(s_hold - z, eps_hold)^beta``. A still tip under
-a saturated stiffness does not move the force with the estimate; but a
-higher kappa keeps the stiffness saturated, so the held surface alone
-ran away where the force bound F_min,z does not cap the reference
-(docs/decisions.md, "The saturation rule takes the softer reading").
-Where the tip moves, the surface is not held (the
-rib's exit of the measured phantom falls away under a held surface). In
-every case ln kappa moves at most
-``slope_kappa_max_rate_per_s``: a single biased solve (the fit reads the
-loop's own large motions worst) moves the estimate by a bounded step.
+The "direct" mode holds kappa instead (and fits every sample): its
+output ln kappa follows the last valid solve's kappa (F / eps^beta, or
+that kappa softened under a saturated stiffness as above), moving at most
+``slope_kappa_max_rate_per_s`` (a single biased solve, and the fit reads
+the loop's own large motions worst, moves the estimate by a bounded
+step); the output surface is ``z + (F / kappa)^(1 / beta)`` (the EKF
+downstream then reads that kappa back).
 """
 
 from __future__ import annotations
@@ -128,8 +118,7 @@ _V_OUT = _S_OUT + 1  # its rate, m/s
 _KAPPA = _V_OUT + 1  # F / eps^beta of the last valid solve (NaN: none)
 _LN_KAPPA = _KAPPA + 1  # "direct": the output ln kappa (NaN: none)
 _S_HOLD = _LN_KAPPA + 1  # the last valid solve's surface, m
-_EPS_HOLD = _S_HOLD + 1  # the last valid solve's penetration, m
-SLOPE_SIZE = _EPS_HOLD + 1
+SLOPE_SIZE = _S_HOLD + 1
 #: Index of the tracked surface in the state (:func:`advance`).
 SURFACE = _S_OUT
 
@@ -162,7 +151,7 @@ def slope_initial_state() -> list[float]:
     state = [0.0] * SLOPE_SIZE
     for i in (
         _T_REF, _T_START, _T_LAST, _SLOPE, _REL_STD, _EPS, _Z_MEAN, _T_MEAN, _S_OUT,
-        _KAPPA, _LN_KAPPA, _S_HOLD, _EPS_HOLD,
+        _KAPPA, _LN_KAPPA, _S_HOLD,
     ):  # fmt: skip
         state[i] = math.nan
     return state
@@ -171,11 +160,10 @@ def slope_initial_state() -> list[float]:
 def _soften_held_kappa(
     s: list[float], force: float, dt: float, p: OnlineEstimatorParams
 ) -> None:
-    """The "tracker" mode's invalid solve under a saturated stiffness (in
-    place): the held kappa moves down towards ``F / (s_hold - z)^beta``
-    (the solve's mean force and tip height) where that reading is the
-    softer one, at most at the rate bound over ``dt`` (since the last
-    solve)."""
+    """An invalid solve under a saturated stiffness (in place), in both
+    modes: the held kappa moves down towards ``F / (s_hold - z)^beta`` (the
+    solve's mean force and tip height) where that reading is the softer
+    one, at most at the rate bound over ``dt`` (since the last solve)."""
     eps = s[_S_HOLD] - s[_Z_MEAN]
     if not eps > 0.0:
         return
@@ -226,36 +214,21 @@ def _solve(s: list[float], t: float, p: OnlineEstimatorParams, saturated: bool) 
         s[_KAPPA] = force / eps**p.beta
         # The solve's own surface and depth (its mean force: no dither damping).
         s[_S_HOLD] = s[_Z_MEAN] + eps
-        s[_EPS_HOLD] = eps
     elif force > 0.0 and math.isfinite(s[_KAPPA]):  # Not valid: kappa held,
-        if saturated and p.slope_kappa_mode == "tracker":
+        if saturated:
             _soften_held_kappa(s, force, d, p)
         s[_EPS] = (force / s[_KAPPA]) ** (1.0 / p.beta)
 
 
 def _direct(
-    s: list[float],
-    z: float,
-    force: float,
-    dt: float,
-    saturated: bool,
-    p: OnlineEstimatorParams,
+    s: list[float], z: float, force: float, dt: float, p: OnlineEstimatorParams
 ) -> None:
     """The "direct" mode's kappa and surface of one sample (in place)."""
     # (advance has returned already unless force > contact_threshold_N >= 0.)
     if not math.isfinite(s[_KAPPA]):
         return
     held = s[_LN_KAPPA]
-    valid = s[_VALID] == 1.0
-    eps_hold = s[_S_HOLD] - z
-    if valid:
-        target = math.log(s[_KAPPA])
-    elif saturated and eps_hold > 0.0:  # (False when NaN)
-        # The softer of the two readings: the surface held, or the depth
-        # held where the tip has risen above it.
-        target = math.log(force) - p.beta * math.log(max(eps_hold, s[_EPS_HOLD]))
-    else:
-        target = held
+    target = math.log(s[_KAPPA])
     if math.isnan(held):
         ln_kappa = target
     else:
@@ -353,7 +326,7 @@ def advance(
     if s[_COUNT] >= SOLVE_EVERY:
         _solve(s, t, p, saturated)
     if direct:
-        _direct(s, z, force, dt, saturated, p)
+        _direct(s, z, force, dt, p)
     elif math.isfinite(s[_EPS]):
         v = s[_V_OUT]
         measured = s[_Z_MEAN] + s[_EPS] + v * (t - s[_T_MEAN])
