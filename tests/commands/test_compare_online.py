@@ -5,22 +5,10 @@ import json
 
 import pytest
 
+from tests.experiments.test_online_compare import _scores
 from vic_drake.cli import main
 from vic_drake.experiments import online_compare
 from vic_drake.experiments.online_compare import DITHER_HZ
-
-
-def _scores(rmse, p99=9.0):
-    keys = (
-        "force_rmse_dithered_truth_N",
-        "dither_rms_N",
-        "penetration_err_mm",
-        "kappa_rel_err_median",
-        "tank_min_J",
-    )
-    return {"force_rmse_true_N": rmse, "rib_p99_force_N": p99} | dict.fromkeys(
-        keys, 0.5
-    )
 
 
 @pytest.mark.parametrize(

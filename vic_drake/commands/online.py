@@ -108,22 +108,11 @@ def _convergence_line(convergence_s) -> str:
 def _compare_online(args: argparse.Namespace) -> int:
     from vic_drake.experiments.online_sweep import (
         comparison_report,
-        online_comparison_sweep,
-        prepare_comparison,
-        scan_progress,
+        run_comparison,
         sweep_json,
     )
 
-    say = Progress()
-    base, runs, phantom = prepare_comparison(args, say)
-    sweep = online_comparison_sweep(
-        base,
-        phantom=phantom,
-        runs=runs,
-        dither_hzs=args.dither_hz,
-        duration_s=args.duration,
-        on_scan=scan_progress(runs, args.dither_hz, say),
-    )
+    sweep = run_comparison(args, Progress())
     emit(
         sweep_json(sweep, args.dither_hz, args.against),
         args.json,

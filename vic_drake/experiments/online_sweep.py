@@ -299,6 +299,22 @@ def scan_progress(runs, dither_hzs, say=None):
     return on_scan
 
 
+def run_comparison(args: argparse.Namespace, say=None) -> dict[str, list[dict]]:
+    """The comparison the parsed arguments ask for: every option checked
+    (:func:`prepare_comparison`, before any scan), then
+    :func:`online_comparison_sweep` with a line per scan through ``say``
+    (default: stderr)."""
+    base, runs, phantom = prepare_comparison(args, say)
+    return online_comparison_sweep(
+        base,
+        phantom=phantom,
+        runs=runs,
+        dither_hzs=args.dither_hz,
+        duration_s=args.duration,
+        on_scan=scan_progress(runs, args.dither_hz, say),
+    )
+
+
 def main(argv=None) -> None:
     """``python -m vic_drake.experiments.online_compare SCENARIO [RUN ...]
     [--dither-hz HZ [HZ ...]] [--force-min-z N] [--against RUN] [--duration
@@ -309,17 +325,9 @@ def main(argv=None) -> None:
     add_comparison_arguments(parser)
     args = parser.parse_args(argv)
     try:
-        base, runs, phantom = prepare_comparison(args)
+        sweep = run_comparison(args)
     except VicDrakeError as exc:
         parser.error(str(exc))
-    sweep = online_comparison_sweep(
-        base,
-        phantom=phantom,
-        runs=runs,
-        dither_hzs=args.dither_hz,
-        duration_s=args.duration,
-        on_scan=scan_progress(runs, args.dither_hz),
-    )
     print(comparison_report(sweep, args.dither_hz, args.against))
 
 
@@ -330,6 +338,7 @@ __all__ = [
     "main",
     "online_comparison_sweep",
     "prepare_comparison",
+    "run_comparison",
     "scan_progress",
     "sweep_json",
     "sweep_wins",
