@@ -22,6 +22,7 @@ from vic_drake.experiments.online_compare import DITHER_HZ
         (["wrong_map"], "unknown runs ['wrong_map']; choose from ['true_map'"),
         (["--against", "nope"], "unknown runs ['nope']"),
         (["--duration", "0"], "--duration must be > 0 s; got 0.0"),
+        (["--duration", "1e6"], "--duration 1e+06 s is far beyond the scenario"),
         (["--force-min-z", "3"], "--force-min-z 3.0: "),
     ],
 )

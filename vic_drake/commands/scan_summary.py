@@ -16,7 +16,6 @@ import math
 from pathlib import Path
 
 from vic_drake.commands.common import fmt_number
-from vic_drake.errors import VicDrakeError
 from vic_drake.paths import (
     CAMPAIGN_SCENARIOS_DIR,
     CAMPAIGN_SPEC_FILE,
@@ -34,28 +33,6 @@ SCAN_DESCRIPTION = (
     "run has none). --out saves the log and the exact scenario beside it; --bag "
     "writes the log as a ROS 2 bag in the real rig's layout."
 )
-
-#: How far past a scenario's full run --duration may reach, s (the probe
-#: only holds still after its trajectory's end).
-MAX_EXTRA_DURATION_S = 60.0
-
-
-def check_scan_duration(scenario, duration_s: float) -> None:
-    """Refuses a --duration far beyond the scenario's trajectory.
-
-    Raises:
-        VicDrakeError: more than :data:`MAX_EXTRA_DURATION_S` past the
-            scenario's full run; the message gives the trajectory's length.
-    """
-    end = float(scenario.trajectory.end_time_s)
-    full = max(float(scenario.total_duration_s), end + 1.0)
-    limit = full + MAX_EXTRA_DURATION_S
-    if duration_s > limit:
-        raise VicDrakeError(
-            f"--duration {duration_s:g} s is far beyond the scenario: its trajectory "
-            f"ends at {end:.1f} s (the default run is {scenario.total_duration_s:.1f} "
-            f"s); give at most {limit:.1f} s"
-        )
 
 
 def campaign_force_limit(path: Path) -> tuple[float, str]:
@@ -192,10 +169,8 @@ def scan_human_summary(out: dict, scenario) -> str:
 
 
 __all__ = [
-    "MAX_EXTRA_DURATION_S",
     "SCAN_DESCRIPTION",
     "campaign_force_limit",
-    "check_scan_duration",
     "scan_human_summary",
     "scan_metrics_dict",
 ]

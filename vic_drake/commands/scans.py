@@ -24,14 +24,13 @@ from vic_drake.commands.common import (
     parse_relaxation,
 )
 from vic_drake.commands.scan_summary import (
-    MAX_EXTRA_DURATION_S,
     SCAN_DESCRIPTION,
-    check_scan_duration,
     scan_human_summary,
     scan_metrics_dict,
 )
 from vic_drake.errors import VicDrakeError
 from vic_drake.paths import PLOT_SUFFIXES, check_output_file, scenario_path
+from vic_drake.run_limits import MAX_EXTRA_DURATION_S, check_scan_duration
 
 
 def _positive(value: str, option: str) -> float:

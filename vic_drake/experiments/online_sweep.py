@@ -26,6 +26,7 @@ import time
 
 from vic_drake.errors import VicDrakeError
 from vic_drake.paths import scenario_path
+from vic_drake.run_limits import check_scan_duration
 
 #: The scores :func:`sweep_wins` compares (lower is better).
 WIN_SCORES = ("force_rmse_true_N", "rib_p99_force_N")
@@ -261,6 +262,8 @@ def prepare_comparison(args: argparse.Namespace, say=None):
     ):
         raise VicDrakeError(f"--duration must be > 0 s; got {args.duration!r}")
     base = load_scenario(scenario_path(args.scenario, say))
+    if args.duration is not None:
+        check_scan_duration(base, args.duration)
     if args.force_min_z is not None:
         base.controller.reference.force_min_z_N = args.force_min_z
         try:

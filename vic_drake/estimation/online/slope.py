@@ -212,7 +212,7 @@ def _solve(s: list[float], t: float, p: OnlineEstimatorParams, saturated: bool) 
         s[_VALID] = 1.0
         s[_EPS] = eps
         s[_KAPPA] = force / eps**p.beta
-        # The solve's own surface and depth (its mean force: no dither damping).
+        # The solve's own surface (its mean force: no dither damping).
         s[_S_HOLD] = s[_Z_MEAN] + eps
     elif force > 0.0 and math.isfinite(s[_KAPPA]):  # Not valid: kappa held,
         if saturated:
