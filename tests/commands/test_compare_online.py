@@ -38,6 +38,12 @@ def test_a_bad_comparison_is_refused_before_any_scan(
     assert f"vic-drake: error: {message}" in err and "Traceback" not in err
 
 
+def test_a_scenario_of_another_controller_is_refused(capsys):
+    assert main(["compare-online", "nominal_cs_synthetic", "true_map"]) == 2
+    err = capsys.readouterr().err
+    assert "runs controller 'cs'; the comparison needs a VS-VF scenario" in err
+
+
 def test_a_misspelt_scenario_names_the_shipped_ones(capsys):
     assert main(["compare-online", "nominal_vs_vf_synthetc", "true_map"]) == 2
     assert (

@@ -262,6 +262,14 @@ def prepare_comparison(args: argparse.Namespace, say=None):
     ):
         raise VicDrakeError(f"--duration must be > 0 s; got {args.duration!r}")
     base = load_scenario(scenario_path(args.scenario, say))
+    kind = base.controller.reference.controller
+    if kind != "vs-vf":
+        raise VicDrakeError(
+            f"scenario {args.scenario!r} runs controller {kind!r}; the comparison "
+            "needs a VS-VF scenario (controller 'vs-vf': it scores VS-VF's force "
+            "reference, made from kappa), e.g. nominal_vs_vf_synthetic or "
+            "real_test_nardi_matForce_lowR"
+        )
     if args.duration is not None:
         check_scan_duration(base, args.duration)
     if args.force_min_z is not None:
