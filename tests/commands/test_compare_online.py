@@ -5,7 +5,7 @@ import json
 
 import pytest
 
-from tests.experiments.test_online_compare import _scores
+from tests.experiments.fake_scores import fake_scores
 from vic_drake.cli import main
 from vic_drake.experiments import online_compare
 from vic_drake.experiments.online_compare import DITHER_HZ
@@ -54,7 +54,7 @@ def test_a_misspelt_scenario_names_the_shipped_ones(capsys):
 def test_the_json_counts_wins_per_frequency(capsys, monkeypatch):
     def fake(base, *, phantom, runs, duration_s, progress, dither_hz):
         rmse = {"wrong_map_+30_dither": 0.68, "online_dither_tracker": dither_hz / 5}
-        return {runs[0]: _scores(rmse[runs[0]])}
+        return {runs[0]: fake_scores(rmse[runs[0]])}
 
     monkeypatch.setattr(online_compare, "online_comparison", fake)
     argv = ["compare-online", "nominal_vs_vf_synthetic", "online_dither_tracker",

@@ -7,6 +7,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from tests.experiments.fake_scores import fake_scores
 from vic_drake.experiments import online_compare
 from vic_drake.experiments.online_compare import (
     COMPARISON_RUNS,
@@ -101,19 +102,6 @@ def test_a_bad_sweep_is_refused_before_any_scan(args, message, capsys, monkeypat
     assert message in err and "Traceback" not in err
 
 
-def _scores(rmse, p99=9.0):
-    keys = [
-        "force_rmse_dithered_truth_N",
-        "dither_rms_N",
-        "penetration_err_mm",
-        "kappa_rel_err_median",
-        "tank_min_J",
-    ]
-    return {"force_rmse_true_N": rmse, "rib_p99_force_N": p99} | dict.fromkeys(
-        keys, 0.5
-    )
-
-
 def test_a_sweep_makes_the_dithered_runs_at_each_frequency_and_the_others_once(
     monkeypatch,
 ):
@@ -121,7 +109,7 @@ def test_a_sweep_makes_the_dithered_runs_at_each_frequency_and_the_others_once(
 
     def fake(base, *, phantom, runs, duration_s, progress, dither_hz):
         made.append((runs[0], dither_hz))
-        return {runs[0]: _scores(dither_hz)}
+        return {runs[0]: fake_scores(dither_hz)}
 
     monkeypatch.setattr(online_compare, "online_comparison", fake)
     seen = []
@@ -154,8 +142,12 @@ def test_a_sweep_makes_the_dithered_runs_at_each_frequency_and_the_others_once(
 
 def test_wins_are_counted_per_frequency_strictly_and_not_on_nan():
     sweep = {
-        "map": [_scores(0.68, 9.6), _scores(0.68, 9.6), _scores(0.68, 9.6)],
-        "online": [_scores(0.55, 9.6), _scores(0.70, 9.5), _scores(np.nan, 9.4)],
+        "map": [fake_scores(0.68, 9.6), fake_scores(0.68, 9.6), fake_scores(0.68, 9.6)],
+        "online": [
+            fake_scores(0.55, 9.6),
+            fake_scores(0.70, 9.5),
+            fake_scores(np.nan, 9.4),
+        ],
     }
     wins = sweep_wins(sweep, "map")
     assert wins == {"online": {"force_rmse_true_N": 1, "rib_p99_force_N": 2, "of": 3}}
