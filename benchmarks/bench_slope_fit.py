@@ -18,6 +18,12 @@ every output between the two checkouts (over samples where both are
 finite; a differing NaN pattern is reported). The issue's budget is 30 us
 p99 per tick.
 
+Each checkout's fit is told the dither's frequency, 3 Hz
+(``--dither-hz``; 0: not told), where its functions take it, so that a
+checkout with the dither as the fit's instrument
+(``slope_instrument``) times that path on every log (the logs' outputs
+then differ from a checkout without it, as they should).
+
     python benchmarks/bench_slope_fit.py --baseline DIR
 """
 
@@ -25,6 +31,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import inspect
 import math
 import sys
 import time
@@ -90,17 +97,22 @@ def _inputs():
     return logs
 
 
-def _step(modules, what: str):
-    """(step(state, row) -> (state, outputs), initial state) of one checkout."""
+def _step(modules, what: str, dither_hz: float):
+    """(step(state, row) -> (state, outputs), initial state) of one checkout
+    (told ``dither_hz`` where its step takes it)."""
     ekf, slope, params_cls = modules
     p = params_cls(method="ekf", surface_from_slope=True, surface_walk_m_per_sqrt_s=0.0)
+    step = ekf.ekf_slope_step if what == "ekf_slope_step" else slope.slope_step
+    extra = (
+        {"dither_hz": dither_hz}
+        if "dither_hz" in inspect.signature(step).parameters
+        else {}
+    )
     if what == "ekf_slope_step":
-        step = ekf.ekf_slope_step
-        return (lambda s, row: step(s, *row, math.nan, p)), ekf.ekf_slope_initial_state(
-            p
-        )
-    step = slope.slope_step
-    return (lambda s, row: step(s, *row, p)), slope.slope_initial_state()
+        return (
+            lambda s, row: step(s, *row, math.nan, p, **extra)
+        ), ekf.ekf_slope_initial_state(p)
+    return (lambda s, row: step(s, *row, p, **extra)), slope.slope_initial_state()
 
 
 def _run(pair, rows, clock=time.perf_counter):
@@ -149,6 +161,13 @@ def main() -> int:
     parser.add_argument("--baseline", metavar="DIR", required=True)
     parser.add_argument("--runs", type=int, default=3, help="runs per log (best of)")
     parser.add_argument(
+        "--dither-hz",
+        type=float,
+        default=3.0,
+        metavar="HZ",
+        help="the dither frequency the fits are told, Hz (0: not told; default 3.0)",
+    )
+    parser.add_argument(
         "--cpu",
         action="store_true",
         help="time ticks with this thread's CPU time instead of the wall clock "
@@ -160,9 +179,12 @@ def main() -> int:
         parser.error(f"--baseline {args.baseline!r} holds no vic_drake package")
     if args.runs < 1:
         parser.error(f"--runs must be >= 1; got {args.runs}")
+    if not (math.isfinite(args.dither_hz) and args.dither_hz >= 0.0):
+        parser.error(f"--dither-hz must be >= 0; got {args.dither_hz}")
     print(versions())
     print(f"this checkout {HERE} against the baseline {args.baseline}")
     print("tick times: " + ("thread CPU time" if args.cpu else "wall clock"))
+    print(f"the fits are told a dither at {args.dither_hz} Hz where they take it")
     new = _load(HERE)
     old = _load(args.baseline)
     from vic_drake.estimation.online.core import OUTPUT_FIELDS
@@ -171,7 +193,7 @@ def main() -> int:
     for log, (t, z, v, f) in _inputs().items():
         rows = list(zip(t.tolist(), z.tolist(), v.tolist(), f.tolist()))
         for what in ("ekf_slope_step", "slope_step"):
-            pair = [_step(modules, what) for modules in (old, new)]
+            pair = [_step(modules, what, args.dither_hz) for modules in (old, new)]
             clock = time.thread_time if args.cpu else time.perf_counter
             results = [_run(pair, rows, clock) for _ in range(args.runs)]
             p50 = np.min([np.median(r[0], axis=1) for r in results], axis=0)

@@ -37,8 +37,10 @@ def test_dithered_runs_set_the_dither_and_only_online_reads_the_slope():
         online_dither = spec.dither and spec.source == "online"
         assert ref.penetration_dither_m == (DITHER_M if spec.dither else 0.0)
         assert s.online_estimator.surface_from_slope == online_dither
-        mode = "direct" if run == "online_dither" else "tracker"
+        mode = "direct" if run in ("online_dither", "online_dither_ls") else "tracker"
         assert s.online_estimator.slope_kappa_mode == mode
+        instrument = "none" if run.endswith("_ls") else "dither"
+        assert s.online_estimator.slope_instrument == instrument
     assert "online_dither" not in UNDITHERED_RUNS and "online" in UNDITHERED_RUNS
     assert "online_dither_tracker" not in UNDITHERED_RUNS
 

@@ -117,3 +117,45 @@ def test_map_surface_is_read_at_the_measured_x_y():
     lookup = tissue.point_lookup()
     assert got == lookup(x, y)[0]
     assert got not in (lookup(y, x)[0], lookup(0.0, 0.0)[0], lookup(x, 0.0)[0])
+
+
+def test_the_dither_frequency_reaches_the_slope_fit():
+    """Ticks through the ports with ``dither_hz`` equal the pure step told the
+    same frequency (the fit's instrument), and differ from it untold."""
+    from vic_drake.estimation.online.ekf import (
+        ekf_slope_initial_state,
+        ekf_slope_step,
+    )
+
+    p = OnlineEstimatorParams(
+        method="ekf", surface_from_slope=True, surface_walk_m_per_sqrt_s=0.0
+    )
+    system = OnlineEstimatorSystem(p, period_s=0.002, dither_hz=3.0)
+    context = system.CreateDefaultContext()
+    told = untold = ekf_slope_initial_state(p)
+    rng = np.random.default_rng(0)
+    for k in range(600):
+        t = 0.002 * k
+        eps = 0.006 + 3e-4 * math.sin(2 * math.pi * 3.0 * t)
+        v = -3e-4 * 2 * math.pi * 3.0 * math.cos(2 * math.pi * 3.0 * t)
+        z, f = 0.1 - eps, 6000.0 * eps**1.35 + rng.normal(0.0, 0.05)
+        _tick(system, context, t, z, v, f, math.nan)
+        told, est = ekf_slope_step(told, t, z, v, f, math.nan, p, dither_hz=3.0)
+        untold, est_untold = ekf_slope_step(untold, t, z, v, f, math.nan, p)
+    out = system.get_estimate_output_port().Eval(context)
+    np.testing.assert_array_equal(out, np.asarray(est, float))
+    assert not np.array_equal(out, np.asarray(est_untold, float))
+
+
+@pytest.mark.parametrize("bad", [0.0, -3.0, math.nan, math.inf])
+def test_dither_frequency_must_be_positive_and_needs_the_slope_fit(bad):
+    with pytest.raises(VicDrakeError, match="dither_hz is for"):
+        OnlineEstimatorSystem(
+            OnlineEstimatorParams(method="ekf"), period_s=0.002, dither_hz=3.0
+        )
+    with pytest.raises(VicDrakeError, match=r"dither_hz must be > 0; got"):
+        OnlineEstimatorSystem(
+            OnlineEstimatorParams(method="ekf", surface_from_slope=True),
+            period_s=0.002,
+            dither_hz=bad,
+        )

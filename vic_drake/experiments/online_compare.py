@@ -18,8 +18,10 @@ well):
   (``online_estimator.surface_from_slope``, no EKF surface state) in the
   fit's "direct" mode (``slope_kappa_mode``: kappa from the fit, held,
   softened towards the force at the held surface while K_z is saturated);
-  "online_dither_tracker" is the same in the fit's "tracker" mode (the
-  estimator's default: the fit's surface through a slow filter). The map
+  "online_dither_tracker" is the same in the fit's "tracker" mode (the fit's
+  surface through a slow filter); both fits take the dither as their
+  instrument (``slope_instrument``), "online_dither_ls" and
+  "online_dither_tracker_ls" are the same two by least squares. The map
   runs with the dither show what the dither alone costs.
 
 ``main``'s ``--force-min-z`` sets VS-VF's F_min,z of every run (the rig's
@@ -82,7 +84,8 @@ class ComparisonRun(NamedTuple):
     """One run of the comparison: the stiffness source ("map" | "online"),
     the map's error (kappa scale, surface offset, m), the online estimator's
     surface ("estimated" | "map"), whether the dither is on and, for the
-    dithered online runs, the slope fit's ``slope_kappa_mode``."""
+    dithered online runs, the slope fit's ``slope_kappa_mode`` and
+    ``slope_instrument``."""
 
     source: str
     kappa_scale: float
@@ -90,6 +93,7 @@ class ComparisonRun(NamedTuple):
     online_surface: str
     dither: bool
     slope_kappa_mode: str = "tracker"
+    slope_instrument: str = "dither"
 
 
 #: The runs of the comparison. "online" reads no map at all;
@@ -107,6 +111,12 @@ COMPARISON_RUNS = {
     "wrong_map_-30_dither": ComparisonRun("map", 0.7, 0.002, "estimated", True),
     "online_dither": ComparisonRun("online", 1.0, 0.0, "estimated", True, "direct"),
     "online_dither_tracker": ComparisonRun("online", 1.0, 0.0, "estimated", True),
+    "online_dither_ls": ComparisonRun(
+        "online", 1.0, 0.0, "estimated", True, "direct", "none"
+    ),
+    "online_dither_tracker_ls": ComparisonRun(
+        "online", 1.0, 0.0, "estimated", True, slope_instrument="none"
+    ),
 }
 
 #: The runs of the comparison before the dither (issue 12's first table).
@@ -138,6 +148,7 @@ def comparison_scenario(
             s.online_estimator.surface_from_slope = True
             s.online_estimator.surface_walk_m_per_sqrt_s = 0.0
             s.online_estimator.slope_kappa_mode = spec.slope_kappa_mode
+            s.online_estimator.slope_instrument = spec.slope_instrument
     return s.validate()
 
 

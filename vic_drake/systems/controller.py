@@ -139,6 +139,9 @@ def MakeVariableImpedanceController(
                 if reads_bounds
                 else None,
                 force_min_z=params.reference.force_min_z_N if reads_bounds else None,
+                dither_hz=params.reference.penetration_dither_hz
+                if reads_bounds
+                else None,
             ),
         )
         builder.Connect(

@@ -85,6 +85,12 @@ class OnlineEstimatorSystem(LeafSystem):
             by F_min,z while F_min,z is at ``force_min_z``
             (:func:`at_flat_force_bound`).
 
+    ``dither_hz`` (only with the estimator's ``surface_from_slope``): the
+    frequency of the controller's penetration dither, Hz, whose phase is
+    2 pi dither_hz t on the same clock: the slope fit's instrument
+    (``OnlineEstimatorParams.slope_instrument``;
+    :mod:`vic_drake.estimation.online.slope_instrument`).
+
     Output ports (state: the last tick's estimate):
         estimate (7): :data:`vic_drake.estimation.online.OUTPUT_FIELDS`.
         kappa_hat (1), lambda_hat (1), variances (2: kappa, lambda),
@@ -103,6 +109,7 @@ class OnlineEstimatorSystem(LeafSystem):
         surface_map=None,
         stiffness_max_z: float | None = None,
         force_min_z: float | None = None,
+        dither_hz: float | None = None,
     ):
         super().__init__()
         if not isinstance(params, OnlineEstimatorParams):
@@ -132,11 +139,15 @@ class OnlineEstimatorSystem(LeafSystem):
         for name, value in (
             ("stiffness_max_z", stiffness_max_z),
             ("force_min_z", force_min_z),
+            ("dither_hz", dither_hz),
         ):
             if value is not None and not self._params.surface_from_slope:
                 raise VicDrakeError(
                     f"{name} is for the estimator's surface_from_slope; it is off"
                 )
+        if dither_hz is not None and not (math.isfinite(dither_hz) and dither_hz > 0.0):
+            raise VicDrakeError(f"dither_hz must be > 0; got {dither_hz!r}")
+        self._dither_hz = 0.0 if dither_hz is None else float(dither_hz)
         self._stiffness_port = None
         if stiffness_max_z is not None:
             if not (math.isfinite(stiffness_max_z) and stiffness_max_z > 0.0):
@@ -191,7 +202,11 @@ class OnlineEstimatorSystem(LeafSystem):
         # this handler: the filter state is read from it and written in place.
         state = discrete_state.value(self._filter).tolist()
         args = (state, context.get_time(), m[_Z], m[_VZ], -m[_FZ], s, self._params)
-        if self._stiffness_port is None and self._references_port is None:
+        if (
+            self._stiffness_port is None
+            and self._references_port is None
+            and self._dither_hz == 0.0
+        ):
             state, est = self._step(*args)
         else:
             saturated = at_bound = False
@@ -203,7 +218,7 @@ class OnlineEstimatorSystem(LeafSystem):
                 at_bound = at_flat_force_bound(
                     float(r[_F_REF_Z]), float(r[_F_MIN_Z]), self._force_min_z
                 )
-            state, est = self._step(*args, saturated, at_bound)
+            state, est = self._step(*args, saturated, at_bound, self._dither_hz)
         discrete_state.get_mutable_value(self._filter)[:] = state
         discrete_state.get_mutable_value(self._estimate)[:] = est
 

@@ -13,7 +13,10 @@ palpation campaign.
   (kappa, lam, optionally the surface offset and beta).
 - :mod:`~vic_drake.estimation.online.slope`: the penetration, hence the
   surface, from the tissue's local slope under a dithered tip (the EKF's
-  surface with ``surface_from_slope``).
+  surface with ``surface_from_slope``);
+  :mod:`~vic_drake.estimation.online.slope_gram` and
+  :mod:`~vic_drake.estimation.online.slope_instrument` its least-squares
+  and its instrumented (the dither as the instrument) solves.
 - :mod:`~vic_drake.estimation.online.replay`: run over a recorded log,
   compare with a reference.
 """

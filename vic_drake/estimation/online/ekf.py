@@ -167,18 +167,22 @@ def ekf_slope_step(
     params: OnlineEstimatorParams,
     saturated: bool = False,
     at_force_bound: bool = False,
+    dither_hz: float = 0.0,
 ) -> tuple[list[float], Estimate]:
     """:func:`ekf_step` on the slope fit's surface when ``surface_z`` is NaN
     (arguments and result as :func:`ekf_step`; ``saturated`` and
     ``at_force_bound``: the controller's stiffness and force at their
-    bounds, for the fit,
+    bounds, and ``dither_hz`` its dither's frequency, for the fit,
     :func:`~vic_drake.estimation.online.slope.slope_step`)."""
     p = params
     if type(state) is not list:  # (slices of an array would be views)
         state = list(state)
     size = state_size(ekf_layout(p)[0])
     fit = state[size:]
-    advance(fit, t, z, z_dot, force, p, state[S_PREV], saturated, at_force_bound)
+    advance(
+        fit, t, z, z_dot, force, p, state[S_PREV], saturated, at_force_bound,
+        dither_hz,
+    )  # fmt: skip
     if math.isnan(surface_z):
         surface_z = fit[SURFACE]
     ekf_state, est = ekf_step(state[:size], t, z, z_dot, force, surface_z, p)

@@ -16,6 +16,9 @@ ONLINE_METHODS = ("rls", "ekf")
 #: How the slope fit's surface is formed
 #: (:mod:`~vic_drake.estimation.online.slope`).
 SLOPE_KAPPA_MODES = ("tracker", "direct")
+#: What the slope fit takes as its instrument
+#: (:mod:`~vic_drake.estimation.online.slope_instrument`).
+SLOPE_INSTRUMENTS = ("dither", "none")
 
 
 def _number(name: str, value, *, low=None, low_open=False, high=None) -> float:
@@ -111,6 +114,11 @@ class OnlineEstimatorParams:
             a saturated stiffness (both modes) and, in "direct" mode, from
             the valid solves too, 1/s (the tissue under the probe at scan
             speed changes its ln kappa by at most ~0.5/s on both phantoms).
+        slope_instrument: "dither" (the fit takes the controller's dither
+            as its instrument, which the loop's own motion does not bias;
+            :mod:`~vic_drake.estimation.online.slope_instrument`) or "none"
+            (least squares). Where the dither's frequency is not known (a
+            replay of a log), the fit is least squares either way.
     """
 
     method: str = "rls"
@@ -143,6 +151,7 @@ class OnlineEstimatorParams:
     slope_surface_time_s: float = 0.5
     slope_kappa_mode: str = "tracker"
     slope_kappa_max_rate_per_s: float = 1.0
+    slope_instrument: str = "dither"
 
     def __post_init__(self):
         self.validate()
@@ -199,6 +208,11 @@ class OnlineEstimatorParams:
                 "OnlineEstimatorParams.slope_kappa_mode must be one of "
                 f"{list(SLOPE_KAPPA_MODES)}; got {self.slope_kappa_mode!r}"
             )
+        if self.slope_instrument not in SLOPE_INSTRUMENTS:
+            raise VicDrakeError(
+                "OnlineEstimatorParams.slope_instrument must be one of "
+                f"{list(SLOPE_INSTRUMENTS)}; got {self.slope_instrument!r}"
+            )
         _number(
             "slope_kappa_max_rate_per_s",
             self.slope_kappa_max_rate_per_s,
@@ -223,4 +237,9 @@ class OnlineEstimatorParams:
         return self
 
 
-__all__ = ["ONLINE_METHODS", "SLOPE_KAPPA_MODES", "OnlineEstimatorParams"]
+__all__ = [
+    "ONLINE_METHODS",
+    "SLOPE_INSTRUMENTS",
+    "SLOPE_KAPPA_MODES",
+    "OnlineEstimatorParams",
+]

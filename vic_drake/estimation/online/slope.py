@@ -16,16 +16,22 @@ exponential forgetting (time constant ``slope_memory_s``),
 (tau = time since now): the cubic takes the slow change of the force as
 the probe travels over the body, so that k and c (the local damping) come
 from the part of the tip's motion that the cubic does not explain: the
-dither and whatever else the loop does (the fit does not need the dither's
-frequency). The fit takes z as the penetration's motion: it does not model
+dither and whatever else the loop does. The loop's own motion answers the
+force that the fit does not model, which biases k low; given the dither's
+frequency (``dither_hz``) and ``slope_instrument`` "dither" (the default),
+the fit takes the dither as its instrument, which that motion does not
+bias (:mod:`vic_drake.estimation.online.slope_instrument`; least squares
+otherwise). The fit takes z as the penetration's motion: it does not model
 the surface under the tip moving with the tip's sideways sway (friction
 follows the force, so that sway cannot be a regressor).
 
 The sums are accumulated every sample; every :data:`SOLVE_EVERY` samples
-they are re-centred (time and height on the newest data) and the 6 x 6
+they are re-centred (time and height on the newest data; on the sample
+before the solve, which halves the work of the costliest tick) and the 6 x 6
 normal equations solved by Cholesky
-(:mod:`vic_drake.estimation.online.slope_gram`, pure Python floats); a
-Gram matrix that is not numerically positive definite gives no solve. A
+(:mod:`vic_drake.estimation.online.slope_gram`, pure Python floats; the
+instrumented fit reuses the cubic's factor); a system that is not
+numerically solvable gives no solve. A
 solve is valid once the contact has lasted ``2 slope_memory_s``, the tip's
 motion beyond the trend has an RMS of at least ``slope_min_motion_m``, k's
 relative standard error (from the fit's residuals) is at most
@@ -87,6 +93,12 @@ from vic_drake.estimation.online.slope_gram import (
     shift_basis,
     solve_sums,
 )
+from vic_drake.estimation.online.slope_instrument import (
+    INSTRUMENT_SIZE,
+    add_instrument_sample,
+    shift_instruments,
+    solve_instrumented,
+)
 
 #: Samples between two solves of the fit.
 SOLVE_EVERY = 10
@@ -118,7 +130,9 @@ _V_OUT = _S_OUT + 1  # its rate, m/s
 _KAPPA = _V_OUT + 1  # F / eps^beta of the last valid solve (NaN: none)
 _LN_KAPPA = _KAPPA + 1  # "direct": the output ln kappa (NaN: none)
 _S_HOLD = _LN_KAPPA + 1  # the last valid solve's surface, m
-SLOPE_SIZE = _S_HOLD + 1
+_D_SOLVE = _S_HOLD + 1  # the time covered by the last re-centring, s
+_I = _D_SOLVE + 1  # the instrument's sums (slope_instrument; zero without)
+SLOPE_SIZE = _I + INSTRUMENT_SIZE
 #: Index of the tracked surface in the state (:func:`advance`).
 SURFACE = _S_OUT
 
@@ -173,30 +187,53 @@ def _soften_held_kappa(
         s[_KAPPA] = math.exp(max(target, held - p.slope_kappa_max_rate_per_s * dt))
 
 
-def _solve(s: list[float], t: float, p: OnlineEstimatorParams, saturated: bool) -> None:
-    """Re-centres the sums on t and the mean heights, then solves (in place)."""
+def _recentre(s: list[float], t: float, p: OnlineEstimatorParams, instrumented: bool):
+    """Moves the sums' basis to t and the data's mean height (in place), the
+    tick before a solve (the two halves of a solve's work on two ticks: the
+    fit does not depend on the basis)."""
     if not s[_G] > 0.0:  # Every sample since the reset was at the force bound.
+        s[_D_SOLVE] = t - s[_T_REF]
         s[_T_REF] = t
-        s[_COUNT] = 0.0
         return
     d = t - s[_T_REF]
     dz = -s[_G + _Z] / s[_G]  # mean z - z0 (G04 / G00 = mean of z0 - z)
-    sums = shift_basis(s[_G : _FF + 1], d, dz, math.exp(-d / p.slope_memory_s))
-    s[_G : _FF + 1] = sums
+    scale = math.exp(-d / p.slope_memory_s)
+    s[_G : _FF + 1] = shift_basis(s[_G : _FF + 1], d, dz, scale)
+    if instrumented:
+        s[_I:] = shift_instruments(s[_I:], d, dz, scale)
+    s[_D_SOLVE] = d
     s[_T_REF] = t
     s[_Z_REF] += dz
+
+
+def _solve(
+    s: list[float],
+    t: float,
+    p: OnlineEstimatorParams,
+    saturated: bool,
+    instrumented: bool,
+) -> None:
+    """Solves the fit (in place), with the dither as the instrument if
+    ``instrumented``."""
     s[_COUNT] = 0.0
+    if not s[_G] > 0.0:  # Every sample since the reset was at the force bound.
+        return
+    d = s[_D_SOLVE]  # the time since the last solve (between re-centrings)
+    sums = s[_G : _FF + 1]
     w0 = sums[0]
-    s[_Z_MEAN] = s[_Z_REF]
-    s[_T_MEAN] = t + sums[1] / w0
+    s[_Z_MEAN] = s[_Z_REF] - sums[_Z] / w0
+    s[_T_MEAN] = s[_T_REF] + sums[1] / w0
     s[_VALID] = 0.0
-    fit = solve_sums(sums)
+    fit = solve_instrumented(sums, s[_I:]) if instrumented else solve_sums(sums)
     if fit is None:  # G not positive definite: no solve, as a singular one.
         return
-    schur_z, slope, residual, g_inv_z = fit
-    # Weighted mean squared residual, and the variance of k: sigma^2 G^-1
-    # scaled by sum w^2 / sum w, which is 1/2 for exponential weights.
-    var_k = max(residual, 0.0) / w0 * g_inv_z * 0.5
+    schur_z, slope, residual, var_factor = fit
+    # Weighted mean squared residual, and the variance of k: sigma^2 times
+    # G^-1's entry (or the instrumented fit's factor), scaled by
+    # sum w^2 / sum w, which is 1/2 for exponential weights whose newest is
+    # 1 (it is exp((t - t_ref) / memory) here: the basis is a sample old).
+    newest = math.exp((t - s[_T_REF]) / p.slope_memory_s)
+    var_k = max(residual, 0.0) / w0 * var_factor * 0.5 * newest
     s[_SLOPE] = slope
     s[_REL_STD] = math.sqrt(var_k) / abs(slope) if slope != 0.0 else math.inf
     s[_MOTION] = math.sqrt(schur_z / w0)
@@ -249,6 +286,7 @@ def slope_step(
     surface_start: float = math.nan,
     saturated: bool = False,
     at_force_bound: bool = False,
+    dither_hz: float = 0.0,
 ) -> tuple[list[float], SlopeEstimate]:
     """One sample of the fit and of the surface it measures.
 
@@ -279,12 +317,20 @@ def slope_step(
         at_force_bound: the controller holds the force at a bound that
             does not follow the dither ("tracker" mode: the sample is not
             fitted; see the module docstring).
+        dither_hz: the frequency of the controller's penetration dither,
+            Hz (its phase is 2 pi dither_hz t): with
+            ``params.slope_instrument`` "dither" the fit takes it as its
+            instrument (:mod:`~vic_drake.estimation.online.slope_instrument`);
+            0 (not known): least squares.
 
     Returns:
         (new state, :class:`SlopeEstimate`).
     """
     s = list(state)
-    advance(s, t, z, z_dot, force, params, surface_start, saturated, at_force_bound)
+    advance(
+        s, t, z, z_dot, force, params, surface_start, saturated, at_force_bound,
+        dither_hz,
+    )  # fmt: skip
     return s, _estimate(s)
 
 
@@ -298,6 +344,7 @@ def advance(
     surface_start: float = math.nan,
     saturated: bool = False,
     at_force_bound: bool = False,
+    dither_hz: float = 0.0,
 ) -> None:
     """:func:`slope_step` on the state ``s`` in place, without the estimate
     (its surface is ``s[SURFACE]``)."""
@@ -316,15 +363,22 @@ def advance(
         s[_T_REF] = s[_T_START] = t
         s[_Z_REF] = z
     direct = p.slope_kappa_mode == "direct"
+    instrumented = dither_hz > 0.0 and p.slope_instrument == "dither"
     if direct or not at_force_bound:
         tau = t - s[_T_REF]
         w = math.exp(tau / p.slope_memory_s)
-        s[_G : _FF + 1] = add_sample(
-            s[_G : _FF + 1], w, tau, s[_Z_REF] - z, -z_dot, force
-        )
+        e = s[_Z_REF] - z
+        s[_G : _FF + 1] = add_sample(s[_G : _FF + 1], w, tau, e, -z_dot, force)
+        if instrumented:
+            phase = 2.0 * math.pi * dither_hz * t
+            s[_I:] = add_instrument_sample(
+                s[_I:], w, tau, e, -z_dot, force, math.sin(phase), math.cos(phase)
+            )
     s[_COUNT] += 1.0
     if s[_COUNT] >= SOLVE_EVERY:
-        _solve(s, t, p, saturated)
+        _solve(s, t, p, saturated, instrumented)
+    elif s[_COUNT] == SOLVE_EVERY - 1:
+        _recentre(s, t, p, instrumented)
     if direct:
         _direct(s, z, force, dt, p)
     elif math.isfinite(s[_EPS]):

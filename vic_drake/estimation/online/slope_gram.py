@@ -131,6 +131,33 @@ def shift_basis(sums, d: float, dz: float, scale: float) -> list[float]:
     ]
 
 
+def cubic_cholesky(sums):
+    """The Cholesky factor of the cubic's 4 x 4 block of G (the first rows
+    of :func:`solve_sums`'s L), as (r0, l10, r1, l20, l21, r2, l30, l31,
+    l32, r3) with ri = 1 / Lii; None where the block is not numerically
+    positive definite."""
+    g00, g01, g02, g03, _, _, g11, g12, g13, _, _, g22, g23, _, _, g33 = sums[:16]
+    if not g00 > 0.0:
+        return None
+    r0 = 1.0 / math.sqrt(g00)
+    l10, l20, l30 = g01 * r0, g02 * r0, g03 * r0
+    p = g11 - l10 * l10
+    if not p > 0.0:
+        return None
+    r1 = 1.0 / math.sqrt(p)
+    l21 = (g12 - l20 * l10) * r1
+    l31 = (g13 - l30 * l10) * r1
+    p = g22 - l20 * l20 - l21 * l21
+    if not p > 0.0:
+        return None
+    r2 = 1.0 / math.sqrt(p)
+    l32 = (g23 - l30 * l20 - l31 * l21) * r2
+    p = g33 - l30 * l30 - l31 * l31 - l32 * l32
+    if not p > 0.0:
+        return None
+    return r0, l10, r1, l20, l21, r2, l30, l31, l32, 1.0 / math.sqrt(p)
+
+
 def solve_sums(sums):
     """The weighted least-squares fit of the force on phi, by Cholesky.
 
@@ -151,30 +178,17 @@ def solve_sums(sums):
         g22, g23, g24, g25, g33, g34, g35, g44, g45, g55,
         b0, b1, b2, b3, b4, b5, ff,
     ) = sums  # fmt: skip
-    if not g00 > 0.0:
+    factor = cubic_cholesky(sums)
+    if factor is None:
         return None
-    r0 = 1.0 / math.sqrt(g00)
-    l10, l20, l30, l40, l50 = g01 * r0, g02 * r0, g03 * r0, g04 * r0, g05 * r0
-    p = g11 - l10 * l10
-    if not p > 0.0:
-        return None
-    r1 = 1.0 / math.sqrt(p)
-    l21 = (g12 - l20 * l10) * r1
-    l31 = (g13 - l30 * l10) * r1
+    r0, l10, r1, l20, l21, r2, l30, l31, l32, r3 = factor
+    l40 = g04 * r0
     l41 = (g14 - l40 * l10) * r1
-    l51 = (g15 - l50 * l10) * r1
-    p = g22 - l20 * l20 - l21 * l21
-    if not p > 0.0:
-        return None
-    r2 = 1.0 / math.sqrt(p)
-    l32 = (g23 - l30 * l20 - l31 * l21) * r2
     l42 = (g24 - l40 * l20 - l41 * l21) * r2
-    l52 = (g25 - l50 * l20 - l51 * l21) * r2
-    p = g33 - l30 * l30 - l31 * l31 - l32 * l32
-    if not p > 0.0:
-        return None
-    r3 = 1.0 / math.sqrt(p)
     l43 = (g34 - l40 * l30 - l41 * l31 - l42 * l32) * r3
+    l50 = g05 * r0
+    l51 = (g15 - l50 * l10) * r1
+    l52 = (g25 - l50 * l20 - l51 * l21) * r2
     l53 = (g35 - l50 * l30 - l51 * l31 - l52 * l32) * r3
     schur_z = g44 - l40 * l40 - l41 * l41 - l42 * l42 - l43 * l43
     if not schur_z > 0.0:
@@ -200,4 +214,11 @@ def solve_sums(sums):
     return schur_z, coef_z, residual, g_inv_zz
 
 
-__all__ = ["GRAM_SIZE", "SUMS_SIZE", "add_sample", "shift_basis", "solve_sums"]
+__all__ = [
+    "GRAM_SIZE",
+    "SUMS_SIZE",
+    "add_sample",
+    "cubic_cholesky",
+    "shift_basis",
+    "solve_sums",
+]
