@@ -166,6 +166,13 @@ class OnlineEstimatorSystem(LeafSystem):
                 "references", REFERENCE_TICK_SIZE
             )
             self._force_min_z = force_min_z
+        # Whether the step takes the slope fit's controller inputs (decided
+        # once: the tick then tests one flag).
+        self._fit_inputs = (
+            self._stiffness_port is not None
+            or self._references_port is not None
+            or self._dither_hz != 0.0
+        )
         self._filter = self.DeclareDiscreteState(np.asarray(state0, float))
         self._estimate = self.DeclareDiscreteState(np.asarray(est0, float))
         self.DeclarePeriodicDiscreteUpdateEvent(float(period_s), 0.0, self._update)
@@ -202,11 +209,7 @@ class OnlineEstimatorSystem(LeafSystem):
         # this handler: the filter state is read from it and written in place.
         state = discrete_state.value(self._filter).tolist()
         args = (state, context.get_time(), m[_Z], m[_VZ], -m[_FZ], s, self._params)
-        if (
-            self._stiffness_port is None
-            and self._references_port is None
-            and self._dither_hz == 0.0
-        ):
+        if not self._fit_inputs:
             state, est = self._step(*args)
         else:
             saturated = at_bound = False
