@@ -228,10 +228,10 @@ def test_the_command_line_called_as_a_function_does_not_restart(capsys):
 def test_the_campaign_leaves_the_session_environment_alone():
     """Dask's pre-spawn settings would stay in this process's os.environ (and
     reach every program it starts later); the engine sets none."""
-    from vic_drake.experiments.campaign.engine import _client
+    from vic_drake.experiments.campaign.cluster import dask_client
 
     before = {k: os.environ.get(k) for k in (ENV_VAR, PRELOAD_VAR)}
-    client, cluster = _client(1, None)
+    client, cluster = dask_client(1, None)
     try:
         client.run(lambda: None)
     finally:
@@ -241,6 +241,7 @@ def test_the_campaign_leaves_the_session_environment_alone():
 
 
 def test_each_campaign_run_process_starts_with_the_allocator(monkeypatch):
+    import vic_drake.experiments.campaign.child as child
     import vic_drake.experiments.campaign.run as run
 
     seen = {}
@@ -249,7 +250,7 @@ def test_each_campaign_run_process_starts_with_the_allocator(monkeypatch):
         seen.update(kwargs)
         return subprocess.CompletedProcess(args, 1, b"", b"stopped by the test")
 
-    monkeypatch.setattr(run.subprocess, "run", fake_run)
+    monkeypatch.setattr(child.subprocess, "run", fake_run)
     plan = run.RunPlan.__new__(run.RunPlan)
     monkeypatch.setattr(run, "failed_row", lambda plan, error, **kw: {"error": error})
     assert "stopped by the test" in run.execute_run_in_child(plan)["error"]

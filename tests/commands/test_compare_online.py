@@ -2,12 +2,13 @@
 short scan through the command line."""
 
 import json
+import os
 
 import pytest
 
 from tests.experiments.fake_scores import fake_scores
 from vic_drake.cli import main
-from vic_drake.experiments import online_compare
+from vic_drake.experiments import online_compare, online_sweep, online_sweep_scans
 from vic_drake.experiments.online_compare import DITHER_HZ
 
 
@@ -24,6 +25,8 @@ from vic_drake.experiments.online_compare import DITHER_HZ
         (["--duration", "0"], "--duration must be > 0 s; got 0.0"),
         (["--duration", "1e6"], "--duration 1e+06 s is far beyond the scenario"),
         (["--force-min-z", "3"], "--force-min-z 3.0: "),
+        (["--workers", "0"], "--workers takes an integer >= 1; got 0"),
+        (["--scheduler", " "], "--scheduler needs an address such as tcp://host:8786"),
     ],
 )
 def test_a_bad_comparison_is_refused_before_any_scan(
@@ -56,7 +59,17 @@ def test_the_json_counts_wins_per_frequency(capsys, monkeypatch):
         rmse = {"wrong_map_+30_dither": 0.68, "online_dither_tracker": dither_hz / 5}
         return {runs[0]: fake_scores(rmse[runs[0]])}
 
+    def in_this_process(jobs, workers, scheduler, on_scan):
+        assert (workers, scheduler) == (os.cpu_count(), None)
+        scores = []
+        for job in jobs:
+            scores.append(online_sweep_scans.comparison_scan(job))
+            on_scan(job.run, job.dither_hz)
+        return scores
+
     monkeypatch.setattr(online_compare, "online_comparison", fake)
+    # Four scans: on a local cluster of the machine's cores, here faked.
+    monkeypatch.setattr(online_sweep, "run_on_cluster", in_this_process)
     argv = ["compare-online", "nominal_vs_vf_synthetic", "online_dither_tracker",
             "--dither-hz", "2.9", "3.5", "--against", "wrong_map_+30_dither", "--json"]  # fmt: skip
     assert main(argv) == 0
@@ -75,7 +88,8 @@ def test_the_json_counts_wins_per_frequency(capsys, monkeypatch):
     assert result["wins"] == {
         "online_dither_tracker": {"force_rmse_true_N": 1, "rib_p99_force_N": 0, "of": 2}
     }
-    assert "scan 4 of 4: wrong_map_+30_dither at 3.5 Hz" in err
+    assert f"4 scans on a local cluster of {os.cpu_count()} worker processes" in err
+    assert "scan 4 of 4 done: wrong_map_+30_dither at 3.5 Hz" in err
 
 
 def test_a_short_comparison_runs_through_the_command_line(capsys):

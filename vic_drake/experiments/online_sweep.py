@@ -8,7 +8,10 @@ dither frequencies"), so one run's margin over another is no evidence.
 several frequencies (a run without the dither once);
 :func:`~vic_drake.experiments.online_compare.comparison_table` shows each
 score's mean and range, and :func:`sweep_wins` counts the frequencies at
-which each run is below another.
+which each run is below another. Its scans run one after another in this
+process, or at once on a Dask cluster
+(:mod:`vic_drake.experiments.online_sweep_scans`), each in a process of
+its own; the command line takes the cluster for more than one scan.
 
 The command line (``vic-drake compare-online``, or ``python -m
 vic_drake.experiments.online_compare``) checks every option before a scan
@@ -21,10 +24,16 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 import time
 
 from vic_drake.errors import VicDrakeError
+from vic_drake.experiments.online_sweep_scans import (
+    ComparisonScan,
+    run_on_cluster,
+    sweep_scans,
+)
 from vic_drake.paths import scenario_path
 from vic_drake.run_limits import check_scan_duration
 
@@ -41,36 +50,53 @@ def online_comparison_sweep(
     duration_s=None,
     progress=None,
     on_scan=None,
+    workers=None,
+    scheduler=None,
 ) -> dict[str, list[dict]]:
     """{run: [scores at each of ``dither_hzs``]}: each dithered run made at
     every frequency (default: the comparison's DITHER_HZ alone); a run
     without the dither (which the frequency does not touch) made once, its
     scores standing at every frequency.
 
-    ``on_scan(run, hz)`` (optional) is called before each scan (hz None for
-    a run without the dither).
+    The scans run one after another in this process, or, with ``workers``
+    or ``scheduler``, at once on a Dask cluster
+    (:func:`~vic_drake.experiments.online_sweep_scans.run_on_cluster`):
+    a local one of ``workers`` processes, or the scheduler at that address.
+
+    ``on_scan(run, hz)`` (optional) is called before each scan in this
+    process, and as each scan ends on a cluster (hz None for a run without
+    the dither). ``progress`` reaches the scans made in this process only.
     """
     from vic_drake.experiments import online_compare
 
     dither_hzs = (online_compare.DITHER_HZ,) if dither_hzs is None else dither_hzs
-    out = {}
-    for run in runs:
-        dithered = online_compare.COMPARISON_RUNS[run].dither
-        hzs = tuple(dither_hzs) if dithered else (None,)
+    scans = sweep_scans(runs, dither_hzs)
+    if workers is not None or scheduler is not None:
+        from vic_drake.scenario import dumps_scenario
+
+        text = dumps_scenario(base)
+        jobs = [ComparisonScan(text, phantom, run, hz, duration_s) for run, hz in scans]
+        scores = run_on_cluster(jobs, workers, scheduler, on_scan)
+    else:
         scores = []
-        for hz in hzs:
+        for run, hz in scans:
             if on_scan is not None:
                 on_scan(run, hz)
-            one = online_compare.online_comparison(
-                base,
-                phantom=phantom,
-                runs=(run,),
-                duration_s=duration_s,
-                progress=progress,
-                dither_hz=online_compare.DITHER_HZ if hz is None else hz,
+            scores.append(
+                online_compare.online_comparison(
+                    base,
+                    phantom=phantom,
+                    runs=(run,),
+                    duration_s=duration_s,
+                    progress=progress,
+                    dither_hz=online_compare.DITHER_HZ if hz is None else hz,
+                )[run]
             )
-            scores.append(one[run])
-        out[run] = scores if dithered else scores * len(dither_hzs)
+    out = {}
+    for (run, hz), one in zip(scans, scores, strict=True):
+        out.setdefault(run, []).append(one)
+        if hz is None:
+            out[run] *= len(dither_hzs)
     return out
 
 
@@ -173,7 +199,7 @@ def sweep_json(sweep: dict[str, list[dict]], dither_hzs, against) -> dict:
 
 def add_comparison_arguments(parser: argparse.ArgumentParser) -> None:
     """The comparison's arguments: SCENARIO, RUN ..., --dither-hz,
-    --force-min-z, --against, --duration."""
+    --force-min-z, --against, --duration, --workers | --scheduler."""
     parser.add_argument(
         "scenario",
         metavar="SCENARIO",
@@ -219,6 +245,21 @@ def add_comparison_arguments(parser: argparse.ArgumentParser) -> None:
         help="simulate only the first S seconds of each scan (default: the whole "
         "scan; the scores cover what was simulated)",
     )
+    where = parser.add_mutually_exclusive_group()
+    where.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        metavar="N",
+        help="local Dask worker processes for the scans (default: the machine's "
+        "cores; a comparison of one scan runs in this process)",
+    )
+    where.add_argument(
+        "--scheduler",
+        default=None,
+        metavar="ADDRESS",
+        help="run the scans on an existing Dask scheduler, e.g. tcp://10.0.0.5:8786",
+    )
 
 
 def prepare_comparison(args: argparse.Namespace, say=None):
@@ -257,6 +298,10 @@ def prepare_comparison(args: argparse.Namespace, say=None):
             f"{', '.join(f'{hz:g}' for hz in twice)} Hz given twice; give each "
             "frequency once"
         )
+    if args.workers is not None and args.workers < 1:
+        raise VicDrakeError(f"--workers takes an integer >= 1; got {args.workers}")
+    if args.scheduler is not None and not args.scheduler.strip():
+        raise VicDrakeError("--scheduler needs an address such as tcp://host:8786")
     if args.duration is not None and not (
         math.isfinite(args.duration) and args.duration > 0.0
     ):
@@ -289,14 +334,14 @@ def prepare_comparison(args: argparse.Namespace, say=None):
     return base, runs, load_scenario_phantom(base)
 
 
-def scan_progress(runs, dither_hzs, say=None):
+def scan_progress(runs, dither_hzs, say=None, *, ended=False):
     """An ``on_scan`` for :func:`online_comparison_sweep` that says "scan k
-    of n: RUN at HZ (t s so far)" through ``say`` (default: stderr), when
-    there is more than one scan."""
-    from vic_drake.experiments.online_compare import COMPARISON_RUNS
-
-    total = sum(len(dither_hzs) if COMPARISON_RUNS[r].dither else 1 for r in runs)
+    of n: RUN at HZ (t s so far)" (with ``ended``, as on a cluster: "scan k
+    of n done: ...") through ``say`` (default: stderr), when there is more
+    than one scan."""
+    total = len(sweep_scans(runs, dither_hzs))
     say = say or (lambda text: print(text, file=sys.stderr, flush=True))
+    done = " done" if ended else ""
     t0, made = time.perf_counter(), 0
 
     def on_scan(run, hz):
@@ -305,7 +350,7 @@ def scan_progress(runs, dither_hzs, say=None):
         if total > 1:
             at = "" if hz is None else f" at {hz:g} Hz"
             elapsed = time.perf_counter() - t0
-            say(f"scan {made} of {total}: {run}{at} ({elapsed:.0f} s so far)")
+            say(f"scan {made} of {total}{done}: {run}{at} ({elapsed:.0f} s so far)")
 
     return on_scan
 
@@ -314,15 +359,27 @@ def run_comparison(args: argparse.Namespace, say=None) -> dict[str, list[dict]]:
     """The comparison the parsed arguments ask for: every option checked
     (:func:`prepare_comparison`, before any scan), then
     :func:`online_comparison_sweep` with a line per scan through ``say``
-    (default: stderr)."""
+    (default: stderr). More than one scan, or ``--scheduler``, runs on a
+    Dask cluster (a local one of ``--workers`` processes, default the
+    machine's cores); a single scan runs in this process."""
+    say = say or (lambda text: print(text, file=sys.stderr, flush=True))
     base, runs, phantom = prepare_comparison(args, say)
+    workers, scheduler = args.workers, args.scheduler
+    on_cluster = scheduler is not None or len(sweep_scans(runs, args.dither_hz)) > 1
+    if on_cluster and scheduler is None and workers is None:
+        workers = os.cpu_count() or 1
+    if on_cluster:
+        where = scheduler or f"a local cluster of {workers} worker processes"
+        say(f"{len(sweep_scans(runs, args.dither_hz))} scans on {where}")
     return online_comparison_sweep(
         base,
         phantom=phantom,
         runs=runs,
         dither_hzs=args.dither_hz,
         duration_s=args.duration,
-        on_scan=scan_progress(runs, args.dither_hz, say),
+        on_scan=scan_progress(runs, args.dither_hz, say, ended=on_cluster),
+        workers=workers if on_cluster else None,
+        scheduler=scheduler,
     )
 
 

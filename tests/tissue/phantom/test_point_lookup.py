@@ -63,3 +63,16 @@ def test_shared_lookups_are_bounded_and_subclasses_keep_their_own():
     assert shifted is not plain
     x, y = -0.06, -0.36
     assert shifted(x, y)[0] == pytest.approx(plain(x, y)[0] + 0.01)
+
+
+def test_a_pickled_phantom_leaves_its_lookups_behind_and_answers_alike():
+    import pickle
+
+    p = plane_phantom()
+    before = len(pickle.dumps(p))
+    fast = p.point_lookup()
+    text = pickle.dumps(p)
+    assert len(text) == before  # The cache is not shipped (to a Dask worker).
+    q = pickle.loads(text)
+    assert "_point_lookups" not in vars(q) and p.point_lookup() is fast
+    assert q.point_lookup()(0.0437, 0.0213) == pytest.approx(fast(0.0437, 0.0213))

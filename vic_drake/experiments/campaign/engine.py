@@ -36,26 +36,25 @@ once the cluster is up: the cluster is closed and nothing is written.
 
 from __future__ import annotations
 
-import contextlib
 import json
-import logging
 import os
 import shlex
-import signal
-import threading
 import time
 from collections.abc import Callable
 from pathlib import Path
 
 import pandas as pd
 
-from vic_drake.ctrl_c import hold_ctrl_c, release_ctrl_c
 from vic_drake.errors import VicDrakeError
+from vic_drake.experiments.campaign.cluster import (
+    ctrl_c_stops_once,
+    dask_client,
+    quiet_logs,
+)
 from vic_drake.experiments.campaign.plan import RunPlan, plan_campaign
 from vic_drake.experiments.campaign.run import failed_row
 from vic_drake.experiments.campaign.spec import CampaignSpec, load_campaign_spec
 from vic_drake.experiments.campaign.stats import per_controller
-from vic_drake.malloc_tuning import allocator
 from vic_drake.paths import (
     CAMPAIGN_SCENARIOS_DIR,
     CAMPAIGN_SPEC_FILE,
@@ -158,104 +157,6 @@ class _Progress:
         )
 
 
-def _client(workers: int | None, scheduler: str | None):
-    import dask
-    from distributed import Client, LocalCluster
-
-    if scheduler:
-        try:
-            return Client(scheduler, timeout="20s"), None
-        except OSError as exc:
-            raise VicDrakeError(
-                f"cannot reach the Dask scheduler {scheduler!r}: {exc}"
-            ) from None
-    n = workers or os.cpu_count() or 1
-    # The runs' own processes get the scans' allocator (execute_run_in_child);
-    # the workers only dispatch. A bad VIC_DRAKE_ALLOCATOR fails here, first.
-    try:
-        allocator(os.environ)
-    except ValueError as exc:
-        raise VicDrakeError(str(exc)) from None
-    from vic_drake.experiments.campaign.workers import IgnoreCtrlC
-
-    # Ctrl-C is held back while the cluster starts. Its threads and worker
-    # processes inherit the blocked signal, so no worker stops half started
-    # and prints its traceback. A Ctrl-C that came meanwhile is taken once
-    # the workers ignore it (the mask restored: KeyboardInterrupt), and the
-    # cluster is closed as after any Ctrl-C.
-    if hasattr(signal, "pthread_sigmask"):
-        # multiprocessing's resource tracker, started with the first worker
-        # process, unblocks SIGINT in the thread that starts it: start it now.
-        from multiprocessing import resource_tracker
-
-        resource_tracker.ensure_running()
-    held = hold_ctrl_c()
-    cluster = client = None
-    try:
-        with dask.config.set({"distributed.scheduler.allowed-failures": 1}):
-            cluster = LocalCluster(
-                n_workers=n,
-                threads_per_worker=1,
-                processes=True,
-                dashboard_address=":0",  # A free port: never clash with another.
-                env={"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"},
-            )
-        client = Client(cluster)
-        client.register_plugin(IgnoreCtrlC())  # Ctrl-C stops the cluster in order.
-        release_ctrl_c(held)
-    except BaseException:
-        with _quiet_logs(True):
-            if client is not None:
-                client.close()
-            if cluster is not None:
-                cluster.close()
-        release_ctrl_c(held)
-        raise
-    return client, cluster
-
-
-@contextlib.contextmanager
-def _ctrl_c_stops_once():
-    """The first Ctrl-C raises KeyboardInterrupt; later ones are ignored.
-
-    They would break the cluster's stop after the first, leaving its threads
-    and processes behind: ``timeout -s INT`` sends two SIGINTs at once, an
-    impatient user may press twice. Only in the main thread (the only one
-    Python delivers signals to).
-    """
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    state = {"raised": False}
-
-    def handler(_signum, _frame):
-        if not state["raised"]:
-            state["raised"] = True
-            raise KeyboardInterrupt
-
-    previous = signal.signal(signal.SIGINT, handler)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGINT, previous)
-
-
-@contextlib.contextmanager
-def _quiet_logs(quiet: bool):
-    """While the cluster stops after Ctrl-C, Dask's and tornado's warnings
-    about the cancelled runs and the lost workers are no news: hidden."""
-    loggers = [logging.getLogger(n) for n in ("distributed", "tornado")]
-    levels = [lg.level for lg in loggers]
-    if quiet:
-        for lg in loggers:
-            lg.setLevel(logging.CRITICAL)
-    try:
-        yield
-    finally:
-        for lg, level in zip(loggers, levels, strict=True):
-            lg.setLevel(level)
-
-
 def _resume_command(spec_path, out: Path, workers, scheduler) -> str:
     """The command that finishes this campaign, for the interrupted message."""
     cmd = ["vic-drake", "campaign", str(spec_path), "--out", str(out)]
@@ -342,8 +243,8 @@ def _submit(
 
     futures = {}
     interrupted = False
-    with _ctrl_c_stops_once():
-        client, cluster = _client(workers, scheduler)
+    with ctrl_c_stops_once():
+        client, cluster = dask_client(workers, scheduler)
         try:
             _create(out, spec_text)
             n_workers = len(client.scheduler_info()["workers"])
@@ -372,7 +273,7 @@ def _submit(
             interrupted = True
             raise
         finally:
-            with _quiet_logs(interrupted):
+            with quiet_logs(interrupted):
                 for fut in futures:
                     fut.cancel()
                 client.close()

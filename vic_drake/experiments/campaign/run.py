@@ -10,9 +10,6 @@ whose log holds NaN is ``status = "nan"``. Neither stops the campaign.
 from __future__ import annotations
 
 import math
-import pickle
-import subprocess
-import sys
 import time
 import traceback
 
@@ -23,7 +20,6 @@ from vic_drake.analysis.contact import contact_loss_intervals, scan_window
 from vic_drake.analysis.scan_metrics import tank_min_J
 from vic_drake.control.references import has_tank
 from vic_drake.experiments.campaign.plan import RunPlan
-from vic_drake.malloc_tuning import tuned_environment
 from vic_drake.scenario import dumps_scenario
 
 #: The columns whose non-finite values make a run a NaN run.
@@ -119,40 +115,19 @@ def execute_run(plan: RunPlan) -> dict:
 
 
 def execute_run_in_child(plan: RunPlan) -> dict:
-    """:func:`execute_run` in a fresh Python process; what the workers run.
+    """:func:`execute_run` in a fresh Python process
+    (:func:`~vic_drake.experiments.campaign.child.run_in_child`: a worker
+    does not grow by each run's Diagram, and a crash costs this run only,
+    an error row); what the workers run."""
+    from vic_drake.experiments.campaign.child import ChildFailed, run_in_child
 
-    A Diagram with Python LeafSystems is never freed in pydrake (its systems'
-    bound methods keep them alive), so a worker that built one Diagram per
-    run would grow by what each run's systems hold (about 100 MB a run on
-    the synthetic chest: docs/decisions.md, "One process per campaign run").
-    The child's memory goes back to the system when it exits, and a crash
-    of the simulation (a signal, not an exception) costs this run only: it
-    becomes an error row, and the worker goes on.
-    """
     t0 = time.perf_counter()
     try:
-        env = tuned_environment()
+        return run_in_child(execute_run, plan)
     except ValueError as exc:  # VIC_DRAKE_ALLOCATOR on this worker's machine.
         return failed_row(plan, str(exc), wall_s=0.0)
-    proc = subprocess.run(
-        [sys.executable, "-m", "vic_drake.experiments.campaign.child"],
-        input=pickle.dumps(plan),
-        capture_output=True,
-        check=False,
-        # The allocator of the processes that run scans (mimalloc where
-        # installed): vic_drake.malloc_tuning.
-        env=env,
-    )
-    if proc.returncode == 0:
-        try:
-            return pickle.loads(proc.stdout)
-        except Exception as exc:  # noqa: BLE001 - reported as the run's error.
-            reason = f"unreadable result ({type(exc).__name__}: {exc})"
-    else:
-        reason = f"the run's process exited with status {proc.returncode}"
-    tail = proc.stderr.decode(errors="replace").strip().splitlines()[-3:]
-    error = reason + (": " + " | ".join(tail) if tail else "")
-    return failed_row(plan, error, wall_s=time.perf_counter() - t0)
+    except ChildFailed as exc:
+        return failed_row(plan, str(exc), wall_s=time.perf_counter() - t0)
 
 
 def failed_row(plan: RunPlan, error: str, *, wall_s: float = math.nan) -> dict:

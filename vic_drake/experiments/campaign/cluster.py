@@ -1,0 +1,132 @@
+"""The Dask cluster that campaigns and sweeps run on, and Ctrl-C around it.
+
+:func:`dask_client` connects to an existing scheduler by address or starts
+a local cluster of worker processes; :func:`ctrl_c_stops_once` and
+:func:`quiet_logs` let the first Ctrl-C stop the work and close the cluster
+in order. Users: :mod:`vic_drake.experiments.campaign.engine` (campaigns)
+and :mod:`vic_drake.experiments.online_sweep` (the closed-loop comparison
+over dither frequencies).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+import signal
+import threading
+
+from vic_drake.ctrl_c import hold_ctrl_c, release_ctrl_c
+from vic_drake.errors import VicDrakeError
+from vic_drake.malloc_tuning import allocator
+
+
+def dask_client(workers: int | None, scheduler: str | None):
+    """(client, cluster): a client of the scheduler at ``scheduler``
+    (cluster None), else of a new local cluster of ``workers`` worker
+    processes (default: the machine's cores), one thread each, whose
+    workers ignore Ctrl-C (:class:`~vic_drake.experiments.campaign.workers.IgnoreCtrlC`).
+    The caller closes both.
+
+    Raises:
+        VicDrakeError: the scheduler cannot be reached, or
+            ``VIC_DRAKE_ALLOCATOR`` is wrong.
+    """
+    import dask
+    from distributed import Client, LocalCluster
+
+    if scheduler:
+        try:
+            return Client(scheduler, timeout="20s"), None
+        except OSError as exc:
+            raise VicDrakeError(
+                f"cannot reach the Dask scheduler {scheduler!r}: {exc}"
+            ) from None
+    n = workers or os.cpu_count() or 1
+    # The runs' own processes get the scans' allocator (execute_run_in_child);
+    # the workers only dispatch. A bad VIC_DRAKE_ALLOCATOR fails here, first.
+    try:
+        allocator(os.environ)
+    except ValueError as exc:
+        raise VicDrakeError(str(exc)) from None
+    from vic_drake.experiments.campaign.workers import IgnoreCtrlC
+
+    # Ctrl-C is held back while the cluster starts. Its threads and worker
+    # processes inherit the blocked signal, so no worker stops half started
+    # and prints its traceback. A Ctrl-C that came meanwhile is taken once
+    # the workers ignore it (the mask restored: KeyboardInterrupt), and the
+    # cluster is closed as after any Ctrl-C.
+    if hasattr(signal, "pthread_sigmask"):
+        # multiprocessing's resource tracker, started with the first worker
+        # process, unblocks SIGINT in the thread that starts it: start it now.
+        from multiprocessing import resource_tracker
+
+        resource_tracker.ensure_running()
+    held = hold_ctrl_c()
+    cluster = client = None
+    try:
+        with dask.config.set({"distributed.scheduler.allowed-failures": 1}):
+            cluster = LocalCluster(
+                n_workers=n,
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=":0",  # A free port: never clash with another.
+                env={"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"},
+            )
+        client = Client(cluster)
+        client.register_plugin(IgnoreCtrlC())  # Ctrl-C stops the cluster in order.
+        release_ctrl_c(held)
+    except BaseException:
+        with quiet_logs(True):
+            if client is not None:
+                client.close()
+            if cluster is not None:
+                cluster.close()
+        release_ctrl_c(held)
+        raise
+    return client, cluster
+
+
+@contextlib.contextmanager
+def ctrl_c_stops_once():
+    """The first Ctrl-C raises KeyboardInterrupt; later ones are ignored.
+
+    They would break the cluster's stop after the first, leaving its threads
+    and processes behind: ``timeout -s INT`` sends two SIGINTs at once, an
+    impatient user may press twice. Only in the main thread (the only one
+    Python delivers signals to).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    state = {"raised": False}
+
+    def handler(_signum, _frame):
+        if not state["raised"]:
+            state["raised"] = True
+            raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGINT, handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+@contextlib.contextmanager
+def quiet_logs(quiet: bool):
+    """While the cluster stops after Ctrl-C, Dask's and tornado's warnings
+    about the cancelled runs and the lost workers are no news: hidden."""
+    loggers = [logging.getLogger(n) for n in ("distributed", "tornado")]
+    levels = [lg.level for lg in loggers]
+    if quiet:
+        for lg in loggers:
+            lg.setLevel(logging.CRITICAL)
+    try:
+        yield
+    finally:
+        for lg, level in zip(loggers, levels, strict=True):
+            lg.setLevel(level)
+
+
+__all__ = ["ctrl_c_stops_once", "dask_client", "quiet_logs"]
