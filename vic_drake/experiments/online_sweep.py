@@ -220,7 +220,8 @@ def add_comparison_arguments(parser: argparse.ArgumentParser) -> None:
         default=None,
         metavar="HZ",
         help="frequencies of the dithered runs' dither, Hz: each dithered run is "
-        "made at each (default 3.0)",
+        "made at each (default 3.0; the online fit was measured at 2.9-3.1 Hz and "
+        "is noisier at 4-6 Hz: README, 'Online estimation in closed loop')",
     )
     parser.add_argument(
         "--force-min-z",
