@@ -228,7 +228,7 @@ def test_the_command_line_called_as_a_function_does_not_restart(capsys):
 def test_the_campaign_leaves_the_session_environment_alone():
     """Dask's pre-spawn settings would stay in this process's os.environ (and
     reach every program it starts later); the engine sets none."""
-    from vic_drake.experiments.campaign.cluster import dask_client
+    from vic_drake.experiments.dask_cluster import dask_client
 
     before = {k: os.environ.get(k) for k in (ENV_VAR, PRELOAD_VAR)}
     client, cluster = dask_client(1, None)
@@ -241,8 +241,8 @@ def test_the_campaign_leaves_the_session_environment_alone():
 
 
 def test_each_campaign_run_process_starts_with_the_allocator(monkeypatch):
-    import vic_drake.experiments.campaign.child as child
     import vic_drake.experiments.campaign.run as run
+    import vic_drake.experiments.child_process as child
 
     seen = {}
 

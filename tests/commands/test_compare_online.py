@@ -25,8 +25,6 @@ from vic_drake.experiments.online_compare import DITHER_HZ
         (["--duration", "0"], "--duration must be > 0 s; got 0.0"),
         (["--duration", "1e6"], "--duration 1e+06 s is far beyond the scenario"),
         (["--force-min-z", "3"], "--force-min-z 3.0: "),
-        (["--workers", "0"], "--workers takes an integer >= 1; got 0"),
-        (["--scheduler", " "], "--scheduler needs an address such as tcp://host:8786"),
     ],
 )
 def test_a_bad_comparison_is_refused_before_any_scan(
@@ -39,6 +37,26 @@ def test_a_bad_comparison_is_refused_before_any_scan(
     assert main(["compare-online", "nominal_vs_vf_synthetic", *args]) == 2
     err = capsys.readouterr().err
     assert f"vic-drake: error: {message}" in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--workers", "0"], "argument --workers: takes an integer >= 1; got '0'"),
+        (["--workers", "two"], "argument --workers: takes an integer >= 1; got 'two'"),
+        (["--scheduler", " "], "argument --scheduler: needs an address such as tcp://"),
+        (
+            ["--workers", "2", "--scheduler", "tcp://h:8786"],
+            "not allowed with argument",
+        ),
+    ],
+)
+def test_a_bad_cluster_is_refused_as_the_options_are_read(args, message, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["compare-online", "nominal_vs_vf_synthetic", *args])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert message in err and "Traceback" not in err
 
 
 def test_a_scenario_of_another_controller_is_refused(capsys):

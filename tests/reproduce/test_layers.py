@@ -27,3 +27,17 @@ def test_the_command_line_parser_does_not_import_the_pipeline():
         "assert r.reproduce is r.pipeline.reproduce and 'scan_scenario' in dir(r)\n"
     )
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+def test_the_command_line_parser_imports_no_simulation_nor_cluster():
+    """The parser (its --help) is built without pydrake, pandas or Dask:
+    the commands import them when they run."""
+    code = (
+        "import sys\n"
+        "from vic_drake.cli import build_parser\n"
+        "build_parser()\n"
+        "heavy = ('pydrake', 'pandas', 'distributed', 'dask', 'matplotlib')\n"
+        "bad = sorted(m for m in heavy if m in sys.modules)\n"
+        "assert not bad, bad\n"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True)

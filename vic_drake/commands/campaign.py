@@ -15,7 +15,7 @@ import argparse
 import math
 
 from vic_drake.commands.common import Progress, add_json_option, emit, help_text
-from vic_drake.errors import VicDrakeError
+from vic_drake.experiments.dask_cluster import add_cluster_arguments
 
 #: The keys --json prints (the command's contract), in order.
 JSON_KEYS = (
@@ -42,18 +42,6 @@ CONTROLLER_KEYS = (
 )
 
 
-def _workers(text: str) -> int:
-    try:
-        n = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(
-            f"takes an integer >= 1; got {text!r}"
-        ) from None
-    if n < 1:
-        raise argparse.ArgumentTypeError(f"takes an integer >= 1; got {text!r}")
-    return n
-
-
 def register(subparsers) -> None:
     p = subparsers.add_parser(
         "campaign",
@@ -64,20 +52,7 @@ def register(subparsers) -> None:
         "spec", metavar="SPEC.yaml", help="the campaign spec (campaigns/*.yaml)"
     )
     p.add_argument("--out", required=True, metavar="DIR", help="output folder")
-    where = p.add_mutually_exclusive_group()
-    where.add_argument(
-        "--workers",
-        type=_workers,
-        default=None,
-        metavar="N",
-        help="local Dask worker processes (default: the machine's cores)",
-    )
-    where.add_argument(
-        "--scheduler",
-        default=None,
-        metavar="ADDRESS",
-        help="an existing Dask scheduler, e.g. tcp://10.0.0.5:8786",
-    )
+    add_cluster_arguments(p, "the campaign's runs")
     p.add_argument(
         "--resume",
         action="store_true",
@@ -128,8 +103,6 @@ def _human(result: dict) -> str:
 def run_campaign_command(args: argparse.Namespace) -> int:
     from vic_drake.experiments.campaign import run_campaign
 
-    if args.scheduler is not None and not args.scheduler.strip():
-        raise VicDrakeError("--scheduler needs an address such as tcp://host:8786")
     result = run_campaign(
         args.spec,
         args.out,

@@ -29,6 +29,7 @@ import sys
 import time
 
 from vic_drake.errors import VicDrakeError
+from vic_drake.experiments.dask_cluster import add_cluster_arguments
 from vic_drake.experiments.online_sweep_scans import (
     ComparisonScan,
     run_on_cluster,
@@ -246,20 +247,8 @@ def add_comparison_arguments(parser: argparse.ArgumentParser) -> None:
         help="simulate only the first S seconds of each scan (default: the whole "
         "scan; the scores cover what was simulated)",
     )
-    where = parser.add_mutually_exclusive_group()
-    where.add_argument(
-        "--workers",
-        type=int,
-        default=None,
-        metavar="N",
-        help="local Dask worker processes for the scans (default: the machine's "
-        "cores; a comparison of one scan runs in this process)",
-    )
-    where.add_argument(
-        "--scheduler",
-        default=None,
-        metavar="ADDRESS",
-        help="run the scans on an existing Dask scheduler, e.g. tcp://10.0.0.5:8786",
+    add_cluster_arguments(
+        parser, "the scans (a comparison of one scan runs in this process)"
     )
 
 
@@ -299,10 +288,6 @@ def prepare_comparison(args: argparse.Namespace, say=None):
             f"{', '.join(f'{hz:g}' for hz in twice)} Hz given twice; give each "
             "frequency once"
         )
-    if args.workers is not None and args.workers < 1:
-        raise VicDrakeError(f"--workers takes an integer >= 1; got {args.workers}")
-    if args.scheduler is not None and not args.scheduler.strip():
-        raise VicDrakeError("--scheduler needs an address such as tcp://host:8786")
     if args.duration is not None and not (
         math.isfinite(args.duration) and args.duration > 0.0
     ):

@@ -4,7 +4,7 @@
 as plain data, which a Dask worker turns into scores by building its own
 Diagram in a process of its own (:func:`comparison_scan_in_child`);
 :func:`run_on_cluster` makes them all on a local cluster or on an existing
-scheduler (:mod:`vic_drake.experiments.campaign.cluster`).
+scheduler (:mod:`vic_drake.experiments.dask_cluster`).
 """
 
 from __future__ import annotations
@@ -58,10 +58,10 @@ def comparison_scan(scan: ComparisonScan) -> dict:
 def comparison_scan_in_child(scan: ComparisonScan) -> tuple[dict | None, str | None]:
     """(scores, None), or (None, why the scan failed): :func:`comparison_scan`
     in a process of its own, what a Dask worker runs
-    (:func:`~vic_drake.experiments.campaign.child.run_in_child`: a worker
+    (:func:`~vic_drake.experiments.child_process.run_in_child`: a worker
     does not grow by each scan's Diagram). A failure is returned, not
     raised, so that the worker does not log its traceback."""
-    from vic_drake.experiments.campaign.child import ChildFailed, run_in_child
+    from vic_drake.experiments.child_process import ChildFailed, run_in_child
 
     try:
         return run_in_child(comparison_scan, scan), None
@@ -72,7 +72,7 @@ def comparison_scan_in_child(scan: ComparisonScan) -> tuple[dict | None, str | N
 def run_on_cluster(jobs, workers, scheduler, on_scan=None) -> list[dict]:
     """The scores of each :class:`ComparisonScan` in ``jobs`` (in order), each
     made by :func:`comparison_scan_in_child` on a Dask cluster
-    (:func:`~vic_drake.experiments.campaign.cluster.dask_client`).
+    (:func:`~vic_drake.experiments.dask_cluster.dask_session`).
 
     Raises:
         VicDrakeError: the cluster cannot be had, or a scan failed (which,
@@ -81,45 +81,28 @@ def run_on_cluster(jobs, workers, scheduler, on_scan=None) -> list[dict]:
     """
     from distributed import as_completed
 
-    from vic_drake.experiments.campaign.cluster import (
-        ctrl_c_stops_once,
-        dask_client,
-        quiet_logs,
-    )
+    from vic_drake.experiments.dask_cluster import dask_session
 
     results = [None] * len(jobs)
-    futures = {}
-    interrupted = False
-    with ctrl_c_stops_once():
-        client, cluster = dask_client(workers, scheduler)
-        try:
-            for i, job in enumerate(jobs):
-                key = f"compare-online-{i}-{job.run}-{time.time_ns()}"
-                fut = client.submit(comparison_scan_in_child, job, pure=False, key=key)
-                futures[fut] = i
-            for fut in as_completed(list(futures)):
-                job = jobs[futures[fut]]
-                try:
-                    scores, why = fut.result()
-                except Exception as exc:  # noqa: BLE001 - e.g. KilledWorker.
-                    scores, why = None, f"{type(exc).__name__}: {exc}"
-                if why is not None:
-                    at = "" if job.dither_hz is None else f" at {job.dither_hz:g} Hz"
-                    raise VicDrakeError(f"the scan {job.run}{at} failed: {why}")
-                results[futures[fut]] = scores
-                if on_scan is not None:
-                    on_scan(job.run, job.dither_hz)
-            return results
-        except KeyboardInterrupt:
-            interrupted = True
-            raise
-        finally:
-            with quiet_logs(interrupted):
-                for fut in futures:
-                    fut.cancel()
-                client.close()
-                if cluster is not None:
-                    cluster.close()
+    with dask_session(workers, scheduler) as (client, futures):
+        for i, job in enumerate(jobs):
+            key = f"compare-online-{i}-{job.run}-{time.time_ns()}"
+            futures[
+                client.submit(comparison_scan_in_child, job, pure=False, key=key)
+            ] = i
+        for fut in as_completed(list(futures)):
+            job = jobs[futures[fut]]
+            try:
+                scores, why = fut.result()
+            except Exception as exc:  # noqa: BLE001 - e.g. KilledWorker.
+                scores, why = None, f"{type(exc).__name__}: {exc}"
+            if why is not None:
+                at = "" if job.dither_hz is None else f" at {job.dither_hz:g} Hz"
+                raise VicDrakeError(f"the scan {job.run}{at} failed: {why}")
+            results[futures[fut]] = scores
+            if on_scan is not None:
+                on_scan(job.run, job.dither_hz)
+    return results
 
 
 __all__ = [

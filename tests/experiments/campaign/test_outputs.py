@@ -33,7 +33,7 @@ def no_cluster(monkeypatch):
     def fail(workers, scheduler):
         raise _NoCluster
 
-    monkeypatch.setattr(engine, "dask_client", fail)
+    monkeypatch.setattr(engine, "dask_session", fail)
 
 
 def _listing(folder: Path) -> list[str]:
@@ -90,7 +90,7 @@ def test_a_campaign_that_cannot_start_leaves_no_folder(tmp_path, monkeypatch):
     def unreachable(workers, scheduler):
         raise VicDrakeError(f"cannot reach the Dask scheduler {scheduler!r}")
 
-    monkeypatch.setattr(engine, "dask_client", unreachable)
+    monkeypatch.setattr(engine, "dask_session", unreachable)
     out = tmp_path / "c2"
     for _ in range(2):  # The retry is not refused as "already holds a campaign".
         with pytest.raises(VicDrakeError, match="cannot reach the Dask scheduler"):

@@ -46,15 +46,11 @@ from pathlib import Path
 import pandas as pd
 
 from vic_drake.errors import VicDrakeError
-from vic_drake.experiments.campaign.cluster import (
-    ctrl_c_stops_once,
-    dask_client,
-    quiet_logs,
-)
 from vic_drake.experiments.campaign.plan import RunPlan, plan_campaign
 from vic_drake.experiments.campaign.run import failed_row
 from vic_drake.experiments.campaign.spec import CampaignSpec, load_campaign_spec
 from vic_drake.experiments.campaign.stats import per_controller
+from vic_drake.experiments.dask_cluster import dask_session
 from vic_drake.paths import (
     CAMPAIGN_SCENARIOS_DIR,
     CAMPAIGN_SPEC_FILE,
@@ -241,11 +237,8 @@ def _submit(
 
     from vic_drake.experiments.campaign.run import execute_run_in_child
 
-    futures = {}
-    interrupted = False
-    with ctrl_c_stops_once():
-        client, cluster = dask_client(workers, scheduler)
-        try:
+    try:
+        with dask_session(workers, scheduler) as (client, futures):
             _create(out, spec_text)
             n_workers = len(client.scheduler_info()["workers"])
             emit(
@@ -269,22 +262,14 @@ def _submit(
                 _record(out, plan, row)
                 bar.add(row)
             return n_workers
-        except KeyboardInterrupt:
-            interrupted = True
-            raise
-        finally:
-            with quiet_logs(interrupted):
-                for fut in futures:
-                    fut.cancel()
-                client.close()
-                if cluster is not None:
-                    cluster.close()
-            if interrupted:
-                kept = len(list((out / "rows").glob("run_*.json")))
-                emit(
-                    f"[{bar.name}] interrupted: {kept} of {bar.total} runs done, kept "
-                    f"in {str(out)!r}; finish the campaign with: {hint}"
-                )
+    except KeyboardInterrupt:
+        # The cluster is closed by now.
+        kept = len(list((out / "rows").glob("run_*.json")))
+        emit(
+            f"[{bar.name}] interrupted: {kept} of {bar.total} runs done, kept "
+            f"in {str(out)!r}; finish the campaign with: {hint}"
+        )
+        raise
 
 
 def summary_dict(spec: CampaignSpec, rows: pd.DataFrame) -> dict:

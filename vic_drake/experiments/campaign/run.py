@@ -116,10 +116,10 @@ def execute_run(plan: RunPlan) -> dict:
 
 def execute_run_in_child(plan: RunPlan) -> dict:
     """:func:`execute_run` in a fresh Python process
-    (:func:`~vic_drake.experiments.campaign.child.run_in_child`: a worker
+    (:func:`~vic_drake.experiments.child_process.run_in_child`: a worker
     does not grow by each run's Diagram, and a crash costs this run only,
     an error row); what the workers run."""
-    from vic_drake.experiments.campaign.child import ChildFailed, run_in_child
+    from vic_drake.experiments.child_process import ChildFailed, run_in_child
 
     t0 = time.perf_counter()
     try:

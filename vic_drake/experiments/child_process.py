@@ -38,7 +38,7 @@ def run_in_child(function, *args):
     """
     env = tuned_environment()
     proc = subprocess.run(
-        [sys.executable, "-m", "vic_drake.experiments.campaign.child"],
+        [sys.executable, "-m", "vic_drake.experiments.child_process"],
         input=pickle.dumps((function, args)),
         capture_output=True,
         check=False,

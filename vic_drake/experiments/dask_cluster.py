@@ -10,6 +10,7 @@ over dither frequencies).
 
 from __future__ import annotations
 
+import argparse
 import contextlib
 import logging
 import os
@@ -129,4 +130,72 @@ def quiet_logs(quiet: bool):
             lg.setLevel(level)
 
 
-__all__ = ["ctrl_c_stops_once", "dask_client", "quiet_logs"]
+@contextlib.contextmanager
+def dask_session(workers: int | None, scheduler: str | None):
+    """Yields ``(client, futures)``: a client of :func:`dask_client` and a
+    dict for the caller's futures. On leaving (also on Ctrl-C, which
+    :func:`ctrl_c_stops_once` turns into one KeyboardInterrupt) the futures
+    are cancelled and the client and a local cluster closed, with Dask's
+    warnings about the cancelled work hidden after Ctrl-C."""
+    futures = {}
+    interrupted = False
+    with ctrl_c_stops_once():
+        client, cluster = dask_client(workers, scheduler)
+        try:
+            yield client, futures
+        except KeyboardInterrupt:
+            interrupted = True
+            raise
+        finally:
+            with quiet_logs(interrupted):
+                for fut in futures:
+                    fut.cancel()
+                client.close()
+                if cluster is not None:
+                    cluster.close()
+
+
+def _workers(text: str) -> int:
+    try:
+        n = int(text)
+    except ValueError:
+        n = 0
+    if n < 1:
+        raise argparse.ArgumentTypeError(f"takes an integer >= 1; got {text!r}")
+    return n
+
+
+def _address(text: str) -> str:
+    if not text.strip():
+        raise argparse.ArgumentTypeError("needs an address such as tcp://host:8786")
+    return text
+
+
+def add_cluster_arguments(parser: argparse.ArgumentParser, what: str) -> None:
+    """``--workers N | --scheduler ADDRESS`` (one or the other): where
+    ``what`` (e.g. "the campaign's runs") runs. Both are checked as they are
+    parsed."""
+    where = parser.add_mutually_exclusive_group()
+    where.add_argument(
+        "--workers",
+        type=_workers,
+        default=None,
+        metavar="N",
+        help=f"local Dask worker processes for {what} (default: the machine's cores)",
+    )
+    where.add_argument(
+        "--scheduler",
+        type=_address,
+        default=None,
+        metavar="ADDRESS",
+        help=f"run {what} on an existing Dask scheduler, e.g. tcp://10.0.0.5:8786",
+    )
+
+
+__all__ = [
+    "add_cluster_arguments",
+    "ctrl_c_stops_once",
+    "dask_client",
+    "dask_session",
+    "quiet_logs",
+]
