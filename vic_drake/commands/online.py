@@ -15,6 +15,9 @@ estimates, at one or several dither frequencies, and scores each run
 against the TRUE tissue: force RMSE, p99 force over the ribs, kappa error,
 tank minimum. With several frequencies each cell is the mean (min-max);
 ``--against RUN`` counts the frequencies at which each run is below RUN.
+More than one scan runs on Dask, each scan in a process of its own: a
+local cluster (``--workers N``, default the cores) or an existing one
+(``--scheduler ADDRESS``).
 """
 
 from __future__ import annotations

@@ -171,17 +171,20 @@ def _address(text: str) -> str:
     return text
 
 
-def add_cluster_arguments(parser: argparse.ArgumentParser, what: str) -> None:
+def add_cluster_arguments(
+    parser: argparse.ArgumentParser, what: str, workers_note: str = ""
+) -> None:
     """``--workers N | --scheduler ADDRESS`` (one or the other): where
-    ``what`` (e.g. "the campaign's runs") runs. Both are checked as they are
-    parsed."""
+    ``what`` (e.g. "the campaign's runs") runs; ``workers_note`` ends the
+    help of --workers. Both are checked as they are parsed."""
     where = parser.add_mutually_exclusive_group()
     where.add_argument(
         "--workers",
         type=_workers,
         default=None,
         metavar="N",
-        help=f"local Dask worker processes for {what} (default: the machine's cores)",
+        help=f"local Dask worker processes for {what} (default: the machine's "
+        f"cores{workers_note})",
     )
     where.add_argument(
         "--scheduler",

@@ -248,7 +248,7 @@ def add_comparison_arguments(parser: argparse.ArgumentParser) -> None:
         "scan; the scores cover what was simulated)",
     )
     add_cluster_arguments(
-        parser, "the scans (a comparison of one scan runs in this process)"
+        parser, "the scans", "; a comparison of one scan runs in this process"
     )
 
 
