@@ -24,7 +24,9 @@ def _plans(path):
     return spec, plan_campaign(spec, load_scenario(base))
 
 
-@pytest.mark.parametrize("name", ["smoke", "breathing", "robustness", "population"])
+@pytest.mark.parametrize(
+    "name", ["smoke", "breathing", "robustness", "population", "population_online"]
+)
 def test_shipped_campaigns_plan_every_run(name):
     spec, plans = _plans(CAMPAIGNS / f"{name}.yaml")
     assert len(plans) == spec.runs
@@ -103,6 +105,19 @@ def test_population_draws_a_patient_per_run(tmp_path):
         plans[0].factors["patient.kappa_scale"]
         != plans[1].factors["patient.kappa_scale"]
     )
+
+
+def test_the_online_source_is_an_arm_of_its_own_on_the_same_patients():
+    spec, plans = _plans(CAMPAIGNS / "population_online.yaml")
+    arms = [p.factors["controller"] for p in plans[:4]]
+    assert arms == ["vs-vf", "vs-vf online", "vs-vf", "vs-vf online"]
+    online = plans[1].scenario()
+    assert online.stiffness_source == "online"
+    assert online.controller.reference.penetration_dither_m == 3e-4
+    assert online.online_estimator.surface_from_slope
+    # Each patient is scanned by both arms; the next pair has another one.
+    kappa = [p.factors["patient.kappa_scale"] for p in plans[:4]]
+    assert kappa[0] == kappa[1] != kappa[2] == kappa[3]
 
 
 @pytest.mark.parametrize(

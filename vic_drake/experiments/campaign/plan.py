@@ -174,8 +174,17 @@ def run_scenario(
         raise VicDrakeError(
             f"campaign {spec.name!r}, {run_id} ({factors}): {exc}"
         ) from None
-    factors.setdefault("controller", scenario.controller.reference.controller)
+    factors[CONTROLLER_FACTOR] = controller_arm(scenario)
     return scenario, factors
+
+
+def controller_arm(scenario: Scenario) -> str:
+    """The run's arm in a campaign's summary: its controller, with " online"
+    where the references come from the online estimates (``stiffness_source``
+    online: the map-free controller), so that a campaign comparing the two
+    sources summarises them apart."""
+    name = scenario.controller.reference.controller
+    return f"{name} online" if scenario.stiffness_source == "online" else name
 
 
 def plan_run(spec: CampaignSpec, base: Scenario, index: int) -> RunPlan:
@@ -204,6 +213,7 @@ __all__ = [
     "CONTROLLERS",
     "RunPlan",
     "apply_controller",
+    "controller_arm",
     "plan_campaign",
     "plan_run",
     "set_field",
