@@ -25,7 +25,15 @@ def _plans(path):
 
 
 @pytest.mark.parametrize(
-    "name", ["smoke", "breathing", "robustness", "population", "population_online"]
+    "name",
+    [
+        "smoke",
+        "breathing",
+        "robustness",
+        "population",
+        "population_online",
+        "robustness_online",
+    ],
 )
 def test_shipped_campaigns_plan_every_run(name):
     spec, plans = _plans(CAMPAIGNS / f"{name}.yaml")
