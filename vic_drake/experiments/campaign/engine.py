@@ -237,8 +237,10 @@ def _submit(
 
     from vic_drake.experiments.campaign.run import execute_run_in_child
 
+    started = False  # A Ctrl-C while the cluster starts leaves nothing to tell.
     try:
         with dask_session(workers, scheduler) as (client, futures):
+            started = True
             _create(out, spec_text)
             n_workers = len(client.scheduler_info()["workers"])
             emit(
@@ -263,6 +265,8 @@ def _submit(
                 bar.add(row)
             return n_workers
     except KeyboardInterrupt:
+        if not started:
+            raise
         # The cluster is closed by now.
         kept = len(list((out / "rows").glob("run_*.json")))
         emit(
