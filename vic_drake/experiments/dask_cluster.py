@@ -26,7 +26,7 @@ def dask_client(workers: int | None, scheduler: str | None):
     """(client, cluster): a client of the scheduler at ``scheduler``
     (cluster None), else of a new local cluster of ``workers`` worker
     processes (default: the machine's cores), one thread each, whose
-    workers ignore Ctrl-C (:class:`~vic_drake.experiments.campaign.workers.IgnoreCtrlC`).
+    workers ignore Ctrl-C (:class:`~vic_drake.experiments.dask_workers.IgnoreCtrlC`).
     The caller closes both.
 
     Raises:
@@ -50,7 +50,7 @@ def dask_client(workers: int | None, scheduler: str | None):
         allocator(os.environ)
     except ValueError as exc:
         raise VicDrakeError(str(exc)) from None
-    from vic_drake.experiments.campaign.workers import IgnoreCtrlC
+    from vic_drake.experiments.dask_workers import IgnoreCtrlC
 
     # Ctrl-C is held back while the cluster starts. Its threads and worker
     # processes inherit the blocked signal, so no worker stops half started

@@ -351,12 +351,13 @@ def run_comparison(args: argparse.Namespace, say=None) -> dict[str, list[dict]]:
     say = say or (lambda text: print(text, file=sys.stderr, flush=True))
     base, runs, phantom = prepare_comparison(args, say)
     workers, scheduler = args.workers, args.scheduler
-    on_cluster = scheduler is not None or len(sweep_scans(runs, args.dither_hz)) > 1
+    n_scans = len(sweep_scans(runs, args.dither_hz))
+    on_cluster = scheduler is not None or n_scans > 1
     if on_cluster and scheduler is None and workers is None:
         workers = os.cpu_count() or 1
     if on_cluster:
         where = scheduler or f"a local cluster of {workers} worker processes"
-        say(f"{len(sweep_scans(runs, args.dither_hz))} scans on {where}")
+        say(f"{n_scans} scans on {where}")
     return online_comparison_sweep(
         base,
         phantom=phantom,

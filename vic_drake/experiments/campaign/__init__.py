@@ -2,9 +2,9 @@
 
 :mod:`.spec` (the campaign YAML), :mod:`.plan` (each run's factors and
 scenario), :mod:`.run` (one run on a worker, its metrics), :mod:`.engine`
-(the Dask cluster, rows on disk, resume; :mod:`.workers`, what its local
-workers run at start), :mod:`.stats` and :mod:`.report` (summary.json,
-summary.html, results.parquet).
+(the runs on Dask, rows on disk, resume; the cluster itself is
+:mod:`vic_drake.experiments.dask_cluster`), :mod:`.stats` and
+:mod:`.report` (summary.json, summary.html, results.parquet).
 """
 
 from vic_drake.experiments.campaign.engine import read_rows, run_campaign

@@ -1,4 +1,5 @@
-"""What the campaign's local Dask workers run at start (a Dask worker plugin).
+"""What a local Dask worker runs at start (a Dask worker plugin), for the
+campaigns and the comparison sweep (:mod:`vic_drake.experiments.dask_cluster`).
 
 Imported only when a local cluster is made (it imports ``distributed``).
 """
@@ -24,8 +25,9 @@ class IgnoreCtrlC(WorkerPlugin):
     stopped on it printed the tracebacks of its nanny and event loop; this
     one leaves its shutdown to the campaign, which closes the cluster in
     order. The handler is a Python function, not SIG_IGN: the runs' own
-    processes (``execute_run_in_child``) start with the default handler
-    again, so Ctrl-C still stops a run at once.
+    processes (:func:`~vic_drake.experiments.child_process.run_in_child`)
+    start with the default handler again, so Ctrl-C still stops a run at
+    once.
     """
 
     name = "vic-drake-ignore-ctrl-c"
