@@ -206,11 +206,12 @@ def test_dither_makes_the_map_free_controller_press_like_the_true_map():
     # 9 s: 5.5 s of scanning over the first rib of the synthetic chest.
     base, scores = short_comparison(("online", "online_dither"), 9.0)
     plain, dithered = scores["online"], scores["online_dither"]
-    # Measured: 1.75 -> 0.51 N vs the true reference, the
-    # dither's own swing included; penetration error 1.36 -> 0.66 mm (the
-    # slope fit's "direct" mode; its "tracker" mode gave 0.40 N, 0.52 mm).
+    # Measured: 1.40 -> 0.56 N vs the true reference, the dither's own
+    # swing included; penetration error 1.04 -> 0.64 mm (the slope fit's
+    # "direct" mode; the true map: 0.35 N, 0.52 mm). Before a latched
+    # contact needed the force to rise, the plain run had 1.75 N, 1.36 mm.
     assert dithered["force_rmse_true_N"] < 0.5 * plain["force_rmse_true_N"]
-    assert dithered["penetration_err_mm"] < 0.5 * plain["penetration_err_mm"]
+    assert dithered["penetration_err_mm"] < 0.7 * plain["penetration_err_mm"]
     assert dithered["tank_min_J"] >= base.controller.tank.min_energy_J
 
 

@@ -324,3 +324,54 @@ def test_confirm_reset_undoes_the_runs_of_an_unconfirmed_reset():
         update(ms, False, 3.0)
     confirm_reset(aux, x, P, saved, 2.2, None, False, 0.1)
     assert x[0] == 3.0 and aux[N_RESTORED] == 1.0
+
+
+def _biased_approach(kappa, lam, bias_N, *, seed=0, spike_at_s=None):
+    """The tip descends at 15 mm/s from 5 mm above a surface at 0.1 m and
+    stops 6 mm deep; the sensor reads a bias on the pressing side throughout.
+    (t, z, z_dot, force, s, the time of the first touch)."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(0.0, 3.0, 0.002)
+    s, speed = 0.1, 0.015
+    z = np.maximum(s + 0.005 - speed * t, s - 0.006)
+    z_dot = np.where(z > s - 0.006, -speed, 0.0)
+    eps = np.maximum(s - z, 0.0)
+    force = (kappa + lam * -z_dot) * eps**1.35 + bias_N
+    force += rng.normal(0.0, 0.05, t.size)
+    if spike_at_s is not None:
+        force[np.searchsorted(t, spike_at_s)] += 3.0
+    return t, z, z_dot, force, s, 0.005 / speed
+
+
+@pytest.mark.parametrize("method", METHODS)
+@pytest.mark.parametrize("bias_N", [0.0, 0.8, 1.9])
+def test_a_bias_in_free_air_is_not_contact(method, bias_N):
+    """A bias above the contact threshold is not read as contact while the
+    force does not rise: the estimate keeps its prior until the probe
+    touches, then is in contact within 0.25 s (the force must rise by the
+    threshold through a 50 ms low-pass: about 0.2 s at this speed)."""
+    kappa, lam = 4000.0, 30000.0
+    t, z, v, f, _, touch = _biased_approach(kappa, lam, bias_N, spike_at_s=0.1)
+    params = OnlineEstimatorParams(method=method, kappa_prior=3000.0)
+    trace = run_online(t, z, v, f, math.nan, params)
+    air = t < touch
+    assert not trace.in_contact[air].any()
+    assert np.all(trace.kappa[air] == 3000.0)
+    first = t[np.flatnonzero(trace.in_contact)[0]]
+    assert touch <= first <= touch + 0.25
+    assert trace.in_contact[-1]
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_without_the_rise_a_bias_reads_as_a_softer_tissue(method):
+    """What the rise guards against: a latch that stands at once reads the
+    depth that the probe travels in free air as a softening tissue."""
+    kappa, lam = 4000.0, 30000.0
+    t, z, v, f, _, touch = _biased_approach(kappa, lam, 1.9)
+    params = OnlineEstimatorParams(
+        method=method, kappa_prior=3000.0, latch_rise_filter_s=0.0
+    )
+    trace = run_online(t, z, v, f, math.nan, params)
+    air = t < touch
+    assert trace.in_contact[air].mean() > 0.9
+    assert trace.kappa[air][-1] < 0.5 * 3000.0

@@ -15,7 +15,9 @@ Per sample (:func:`prepare`):
 - the surface is the input's when finite; otherwise it is latched at first
   contact at the height where the current estimate gives the measured force
   (``z + (F / kappa_hat)^(1 / beta)``) and released when the force drops
-  below the contact threshold (the next contact latches anew);
+  below the contact threshold (the next contact latches anew). The latch
+  stands once the force has risen from its lowest value (:func:`_latch`),
+  where the surface is latched; until then the sample is out of contact;
 - the surface rate s_dot is a first-order low-pass of its finite
   differences, restarted after a gap longer than ``max_gap_s``;
 - contact: force above ``contact_threshold_N`` and penetration above
@@ -54,7 +56,10 @@ T_UPDATE = 8  # time of the last update, s (NaN before the first)
 CLIP_START = 9  # time of the first of the clipped updates in a row, s (NaN: none)
 RESET_T = 10  # time of the last covariance reset not yet confirmed, s (NaN: none)
 N_RESTORED = 11  # unconfirmed resets undone at the end of their contact
-AUX_SIZE = 12
+F_FILT = 12  # the force through the latch's low-pass, N (NaN before the first)
+LATCH_F_MIN = 13  # lowest filtered force since the latch, N (NaN: no latch)
+LATCH_OK = 14  # 1 once the latched contact is confirmed by a rise of the force
+AUX_SIZE = 15
 
 #: Fields of the estimator's outputs, in order (:class:`Estimate`).
 OUTPUT_FIELDS = (
@@ -95,6 +100,7 @@ def initial_state(x0: list[float], p0_diag: list[float]) -> list[float]:
     n = len(x0)
     aux = [math.nan, math.nan, math.nan, 0.0, 0.0, 0.0, 0.0, 0.0, math.nan]
     aux += [math.nan, math.nan, 0.0]  # CLIP_START, RESET_T, N_RESTORED
+    aux += [math.nan, math.nan, 0.0]  # F_FILT, LATCH_F_MIN, LATCH_OK
     P = [0.0] * (n * n)
     for i in range(n):
         P[i * n + i] = float(p0_diag[i])
@@ -145,10 +151,7 @@ def prepare(
     if math.isfinite(surface_z):
         s = surface_z
     else:
-        if not contact:
-            aux[S_LATCH] = math.nan
-        elif math.isnan(aux[S_LATCH]):
-            aux[S_LATCH] = z + (force / kappa_hat) ** (1.0 / beta)
+        contact = _latch(aux, dt, z, force, contact, kappa_hat, beta, p)
         s = aux[S_LATCH]
     s_prev = aux[S_PREV]
     if math.isfinite(s) and math.isfinite(s_prev) and 0.0 < dt <= p.max_gap_s:
@@ -158,6 +161,51 @@ def prepare(
         aux[S_DOT] = 0.0
     aux[S_PREV] = s
     return s, aux[S_DOT], contact
+
+
+def _latch(
+    aux: list[float],
+    dt: float,
+    z: float,
+    force: float,
+    touching: bool,
+    kappa_hat: float,
+    beta: float,
+    p: OnlineEstimatorParams,
+) -> bool:
+    """The surface latched at first contact (in ``aux``); returns whether the
+    sample counts as contact.
+
+    The surface is latched where the force, low-passed with
+    ``latch_rise_filter_s``, is lowest since the force crossed the contact
+    threshold (where it started to rise; at that sample's force). The latch
+    stands once that force has risen by ``contact_threshold_N`` above its
+    lowest value. Until then the sample is not in contact: a force that
+    does not rise as the probe goes on is not the tissue's (a sensor's bias
+    reads as contact in free air, and the estimate would read the depth
+    that the probe travels as a softer tissue). ``latch_rise_filter_s`` 0:
+    the latch stands at once, at the first sample.
+    """
+    tau = p.latch_rise_filter_s
+    f = aux[F_FILT]
+    if math.isnan(f) or not 0.0 < dt <= p.max_gap_s:
+        f = force
+    else:
+        f += dt / (tau + dt) * (force - f)
+    aux[F_FILT] = f
+    if not touching:
+        aux[S_LATCH] = aux[LATCH_F_MIN] = math.nan
+        aux[LATCH_OK] = 0.0
+        return False
+    if aux[LATCH_OK] == 1.0:
+        return True
+    if not f >= aux[LATCH_F_MIN]:  # A new low (NaN: the latch's first sample).
+        aux[LATCH_F_MIN] = f
+        aux[S_LATCH] = z + (force / kappa_hat) ** (1.0 / beta)
+    if tau == 0.0 or f - aux[LATCH_F_MIN] >= p.contact_threshold_N:
+        aux[LATCH_OK] = 1.0
+        return True
+    return False
 
 
 def record_clip(

@@ -69,6 +69,13 @@ class OnlineEstimatorParams:
         beta_walk_per_sqrt_s: EKF random walk of beta per sqrt(s).
         contact_threshold_N: contact when the force exceeds this, N.
         min_penetration_m: and the penetration exceeds this, m.
+        latch_rise_filter_s: without a surface (input or slope fit's), a
+            surface latched at first contact stands once the force,
+            low-passed with this time constant, s, has risen by
+            ``contact_threshold_N`` above its lowest value since the latch;
+            until then the samples do not update the estimate (a sensor's
+            bias on the pressing side reads as contact in free air); 0: the
+            latch stands at once.
         gate_sigma: innovations are clipped at this many predicted
             standard deviations (a spike moves the estimate by a bounded
             step, a real change still gets through).
@@ -137,6 +144,7 @@ class OnlineEstimatorParams:
     beta_walk_per_sqrt_s: float = 0.0
     contact_threshold_N: float = CONTACT_THRESHOLD_N
     min_penetration_m: float = 0.5e-3
+    latch_rise_filter_s: float = 0.05
     gate_sigma: float = 4.0
     clip_reset_s: float = 0.05
     reset_confirm_s: float = 0.1
@@ -183,6 +191,7 @@ class OnlineEstimatorParams:
             "beta_walk_per_sqrt_s",
             "contact_threshold_N",
             "min_penetration_m",
+            "latch_rise_filter_s",
             "surface_rate_time_constant_s",
             "clip_reset_s",
             "reset_confirm_s",
