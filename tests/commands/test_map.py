@@ -62,6 +62,34 @@ def test_bad_input_exits_2(tmp_path, capsys, args, message):
 
 
 @pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--workers", "0"], "argument --workers: takes an integer >= 1; got '0'"),
+        (
+            ["--workers", "2", "--scheduler", "tcp://h:8786"],
+            "argument --scheduler: not allowed with argument --workers",
+        ),
+    ],
+)
+def test_a_bad_cluster_is_refused_as_the_options_are_read(
+    tmp_path, capsys, args, message
+):
+    with pytest.raises(SystemExit) as exc:
+        main(["map", "--out", str(tmp_path / "o"), *args])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert message in err and "Traceback" not in err
+    assert not (tmp_path / "o").exists()
+
+
+def test_the_palpations_run_in_this_process_by_default():
+    from vic_drake.cli import build_parser
+
+    args = build_parser().parse_args(["map", "--out", "o"])
+    assert (args.workers, args.scheduler) == (1, None)
+
+
+@pytest.mark.parametrize(
     "option, value", [("--phantom", "cardboard"), ("--kernel", "cubic")]
 )
 def test_choices_are_argparse_choices(tmp_path, capsys, option, value):

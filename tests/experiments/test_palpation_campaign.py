@@ -87,3 +87,31 @@ def test_run_campaign_on_a_small_region():
     assert np.sqrt(np.mean(err**2)) < 0.04
     assert result.lag_s == pytest.approx(0.056)
     assert result.region_m == region
+
+
+def test_a_campaign_on_a_local_cluster_equals_the_one_in_this_process():
+    """Two batches either way (batch_size 3 of 6 points): the same jobs, so
+    the same fits to the bit, whether on Dask or here."""
+    phantom = SyntheticChestPhantom()
+    region = (-0.08, -0.06, -0.37, -0.36)
+    here = run_campaign(phantom, CampaignParams(region_m=region, seed=2, batch_size=3))
+    lines = []
+    there = run_campaign(
+        phantom,
+        CampaignParams(region_m=region, seed=2, batch_size=3, workers=2),
+        progress=lines.append,
+    )
+    assert there.points.equals(here.points)
+    assert there.lag_s == here.lag_s
+    assert "palpating 6 points on 2 local Dask worker(s)" in lines
+    assert sorted(line for line in lines if line.startswith("batch")) == [
+        "batch 1 of 2 done (3 points)",
+        "batch 2 of 2 done (3 points)",
+    ]
+
+
+def test_an_unreachable_scheduler_is_named():
+    phantom = SyntheticChestPhantom()
+    params = CampaignParams(region_m=(-0.08, -0.06, -0.37, -0.36))
+    with pytest.raises(VicDrakeError, match="cannot reach the Dask scheduler"):
+        run_campaign(phantom, params, scheduler="tcp://127.0.0.1:9")

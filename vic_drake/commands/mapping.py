@@ -28,6 +28,7 @@ from vic_drake.commands.common import (
     to_json,
 )
 from vic_drake.errors import VicDrakeError
+from vic_drake.experiments.dask_cluster import add_cluster_arguments
 from vic_drake.paths import check_output_dir
 
 MAX_MAP_POINTS = 20_000_000  # 2001 x 1001 at 0.1 mm over 20 x 10 cm is 2 M.
@@ -109,12 +110,7 @@ def register(subparsers) -> None:
         action="store_true",
         help="model log kappa and log lambda in the GPs (default: the values, as the paper)",
     )
-    parser.add_argument(
-        "--workers",
-        type=int,
-        default=1,
-        help="processes for the simulation (default 1)",
-    )
+    add_cluster_arguments(parser, "the palpations' simulation", in_process_default=True)
     parser.add_argument(
         "--no-figures", action="store_true", help="skip the PNG figures"
     )
@@ -169,8 +165,6 @@ def run_map(args) -> int:
         raise VicDrakeError(
             f"--time-step-ms must be <= 2 (the sensor's 500 Hz period); got {args.time_step_ms!r}"
         )
-    if args.workers is None or args.workers < 1:
-        raise VicDrakeError(f"--workers must be an integer >= 1; got {args.workers!r}")
     out = _prepare_out(args.out)
     phantom = load_phantom(args.phantom, data_dir=args.data_dir)
     region = _parse_region(args.region) if args.region else default_region(phantom)
@@ -206,6 +200,7 @@ def run_map(args) -> int:
         resolution_m=resolution_m,
         gp=GpMapParams(kernel=args.kernel, seed=args.seed, log_target=args.log_gp),
         progress=progress,
+        scheduler=args.scheduler,
     )
     campaign, tmap, comparison = mapped.campaign, mapped.tissue_map, mapped.comparison
     tmap.save_npz(out / "maps.npz")

@@ -43,10 +43,10 @@ class CampaignParams:
             mostly per-step overhead, so bigger banks are cheaper per point
             (see docs/decisions.md, "Campaign batch size").
         workers: worker processes for the simulation (1: in-process). With
-            more, batches run in "spawn" processes, so a calling script needs
-            the ``if __name__ == "__main__":`` guard. On 2 cores the gain is
-            small (see docs/decisions.md, "Campaign workers"), hence 1 by
-            default.
+            more, the batches run on a local Dask cluster of that many
+            worker processes, so a calling script needs the ``if __name__ ==
+            "__main__":`` guard. On 2 cores the gain is small (see
+            docs/decisions.md, "Campaign workers"), hence 1 by default.
         seed: seed of the sensor noise (batch k uses seed + k).
     """
 

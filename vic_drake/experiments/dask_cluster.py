@@ -3,9 +3,10 @@
 :func:`dask_client` connects to an existing scheduler by address or starts
 a local cluster of worker processes; :func:`ctrl_c_stops_once` and
 :func:`quiet_logs` let the first Ctrl-C stop the work and close the cluster
-in order. Users: :mod:`vic_drake.experiments.campaign.engine` (campaigns)
-and :mod:`vic_drake.experiments.online_sweep` (the closed-loop comparison
-over dither frequencies).
+in order. Users: :mod:`vic_drake.experiments.campaign.engine` (campaigns),
+:mod:`vic_drake.experiments.online_sweep` (the closed-loop comparison
+over dither frequencies) and :mod:`vic_drake.experiments.palpation_campaign`
+(the palpations behind ``vic-drake map``).
 """
 
 from __future__ import annotations
@@ -172,19 +173,30 @@ def _address(text: str) -> str:
 
 
 def add_cluster_arguments(
-    parser: argparse.ArgumentParser, what: str, workers_note: str = ""
+    parser: argparse.ArgumentParser,
+    what: str,
+    workers_note: str = "",
+    *,
+    in_process_default: bool = False,
 ) -> None:
     """``--workers N | --scheduler ADDRESS`` (one or the other): where
     ``what`` (e.g. "the campaign's runs") runs; ``workers_note`` ends the
-    help of --workers. Both are checked as they are parsed."""
+    help of --workers. Both are checked as they are parsed.
+    ``in_process_default``: --workers defaults to 1, which the caller runs in
+    its own process (else None: the machine's cores)."""
     where = parser.add_mutually_exclusive_group()
+    default = (
+        "1: in this process, no cluster"
+        if in_process_default
+        else ("the machine's cores")
+    )
     where.add_argument(
         "--workers",
         type=_workers,
-        default=None,
+        default=1 if in_process_default else None,
         metavar="N",
-        help=f"local Dask worker processes for {what} (default: the machine's "
-        f"cores{workers_note})",
+        help=f"local Dask worker processes for {what} (default {default}"
+        f"{workers_note})",
     )
     where.add_argument(
         "--scheduler",

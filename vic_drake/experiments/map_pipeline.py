@@ -76,6 +76,7 @@ def run_map_pipeline(
     gp: GpMapParams | None = None,
     compare: bool = True,
     progress=None,
+    scheduler: str | None = None,
 ) -> MapPipelineResult:
     """Palpates a phantom on a grid, fits every point, maps it, compares it.
 
@@ -88,6 +89,9 @@ def run_map_pipeline(
         compare: also compare the maps with the phantom's truth (samples
             the phantom on the whole map grid).
         progress: optional callable(str) for progress lines.
+        scheduler: simulate the palpations on the Dask cluster at this
+            address (see
+            :func:`~vic_drake.experiments.palpation_campaign.run_campaign`).
 
     Returns:
         A :class:`MapPipelineResult`.
@@ -96,7 +100,7 @@ def run_map_pipeline(
     params = params or CampaignParams()
     if params.region_m is None:
         params = replace(params, region_m=default_region(phantom))
-    campaign = run_campaign(phantom, params, progress=progress)
+    campaign = run_campaign(phantom, params, progress=progress, scheduler=scheduler)
     say(f"surface fit and GP maps every {resolution_m * 1e3:g} mm")
     tissue_map = build_tissue_map(
         campaign.points,

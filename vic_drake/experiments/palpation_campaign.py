@@ -6,15 +6,14 @@ the surface, 8 mm amplitude, 2.5 Hz, 5 s) while the F/T sensor logs the
 force; a Hunt-Crossley fit at fixed beta gives kappa and lambda per point.
 Here the palpations run on the indenter bank
 (:func:`~vic_drake.experiments.palpation_sim.simulate_palpations`: all points
-of a batch in ONE diagram, batches split over worker processes), then each
+of a batch in ONE diagram; with more than one worker, or a scheduler, the
+batches run on Dask: :mod:`vic_drake.experiments.dask_cluster`), then each
 point is reduced by :func:`~vic_drake.experiments.palpation_fit.fit_point`.
 """
 
 from __future__ import annotations
 
-import multiprocessing
 import time
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -99,10 +98,38 @@ class CampaignResult:
         return self.points[self.points["ok"]]
 
 
-def _pool(workers: int):
-    return ProcessPoolExecutor(
-        max_workers=workers, mp_context=multiprocessing.get_context("spawn")
-    )
+def _simulate_on_cluster(make_jobs, workers, scheduler, say) -> list:
+    """The batches of ``make_jobs(cluster workers)`` simulated on Dask (a
+    local cluster of ``workers`` processes, or the cluster at ``scheduler``),
+    in order.
+
+    Raises:
+        VicDrakeError: the cluster cannot be had, or a batch failed (the
+            others are cancelled).
+        KeyboardInterrupt: on Ctrl-C, once the cluster is closed.
+    """
+    from distributed import as_completed
+
+    from vic_drake.experiments.dask_cluster import dask_session
+
+    with dask_session(workers, scheduler) as (client, futures):
+        jobs = make_jobs(max(1, len(client.scheduler_info()["workers"])))
+        stamp = time.time_ns()
+        for k, job in enumerate(jobs):
+            key = f"palpation-batch-{k}-{stamp}"
+            futures[client.submit(_simulate_batch, job, pure=False, key=key)] = k
+        outs = [None] * len(jobs)
+        for done, fut in enumerate(as_completed(list(futures)), start=1):
+            k = futures[fut]
+            try:
+                outs[k] = fut.result()
+            except Exception as exc:  # noqa: BLE001 - e.g. KilledWorker.
+                raise VicDrakeError(
+                    f"palpation batch {k + 1} of {len(jobs)} failed: "
+                    f"{type(exc).__name__}: {exc}"
+                ) from None
+            say(f"batch {done} of {len(jobs)} done ({len(outs[k][0])} points)")
+    return outs
 
 
 def run_campaign(
@@ -112,6 +139,7 @@ def run_campaign(
     keep_records: bool = False,
     progress=None,
     relaxation: RelaxationParams | None = DEFAULT_RELAXATION,
+    scheduler: str | None = None,
 ) -> CampaignResult:
     """Palpates a phantom on a grid and fits every point.
 
@@ -123,6 +151,10 @@ def run_campaign(
             Hunt-Crossley); see :func:`simulate_palpations`.
         keep_records: keep the simulated logs in the result.
         progress: optional callable(str) for progress lines.
+        scheduler: address of an existing Dask scheduler to simulate the
+            batches on (``params.workers`` is then not read). Without it,
+            ``params.workers`` > 1 starts a local Dask cluster of that many
+            worker processes, and 1 simulates in this process.
 
     Returns:
         A :class:`CampaignResult`.
@@ -136,29 +168,38 @@ def run_campaign(
     beta = float(phantom.beta)
     n = x.size
     workers = int(params.workers)
-    n_batches = max(int(np.ceil(n / params.batch_size)), min(workers, n))
-    chunks = np.array_split(np.arange(n), n_batches)
-    jobs = [
-        (
-            x[c],
-            y[c],
-            truth.surface_z_m[c],
-            truth.kappa[c],
-            truth.lam[c],
-            beta,
-            params,
-            params.seed + k,
-            relaxation,
-        )
-        for k, c in enumerate(chunks)
-    ]
-    say(f"palpating {n} points in {len(jobs)} batch(es) on {workers} worker(s)")
+
+    def make_jobs(n_workers: int) -> list:
+        n_batches = max(int(np.ceil(n / params.batch_size)), min(n_workers, n))
+        chunks = np.array_split(np.arange(n), n_batches)
+        return [
+            (
+                x[c],
+                y[c],
+                truth.surface_z_m[c],
+                truth.kappa[c],
+                truth.lam[c],
+                beta,
+                params,
+                params.seed + k,
+                relaxation,
+            )
+            for k, c in enumerate(chunks)
+        ]
+
     t0 = time.perf_counter()
-    if workers > 1 and len(jobs) > 1:
-        with _pool(workers) as pool:
-            outs = list(pool.map(_simulate_batch, jobs))
-    else:
+    if scheduler is None and workers == 1:
+        jobs = make_jobs(1)
+        say(f"palpating {n} points in {len(jobs)} batch(es) in this process")
         outs = [_simulate_batch(job) for job in jobs]
+    else:
+        where = (
+            f"the Dask cluster at {scheduler}"
+            if scheduler
+            else (f"{workers} local Dask worker(s)")
+        )
+        say(f"palpating {n} points on {where}")
+        outs = _simulate_on_cluster(make_jobs, workers, scheduler, say)
     records = [r for batch, _ in outs for r in batch]
     simulate_s = time.perf_counter() - t0
     say(f"simulated {n} palpations in {simulate_s:.1f} s")
