@@ -98,6 +98,17 @@ def _human(result: dict) -> str:
             f"{ci:>16} {_num(v['contact_loss_s_p50'], 10, 3)} "
             f"{_num(v['tank_min_J'], 10, 3)}"
         )
+    for c in result.get("paired", []):
+        loss, over = c["contact_loss"], c["exceedance"]
+        lines.append(
+            f"paired, {c['second']} - {c['first']} ({c['pairs']} pairs): peakF "
+            f"p50 {c['peak_force_diff_N_p50']:+.2f} N "
+            f"[{c['peak_force_diff_N_p10']:+.2f}, {c['peak_force_diff_N_p90']:+.2f}]; "
+            f"contact lost by {c['second']} alone in {loss['only_second']}, by "
+            f"{c['first']} alone in {loss['only_first']} (McNemar p "
+            f"{loss['mcnemar_p']:.3g}); above the limit alone: {over['only_second']}"
+            f" / {over['only_first']}"
+        )
     return "\n".join(lines)
 
 
@@ -117,5 +128,6 @@ def run_campaign_command(args: argparse.Namespace) -> int:
         name: {key: v[key] for key in CONTROLLER_KEYS}
         for name, v in result["per_controller"].items()
     }
-    emit(out, args.json, _human(out))
+    # The paired comparison is in summary.json; --json keeps its keys.
+    emit(out, args.json, _human({**out, "paired": result.get("paired", [])}))
     return 0 if out["failed"] == 0 else 1

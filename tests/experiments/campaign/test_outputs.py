@@ -175,3 +175,34 @@ def test_after_a_resume_the_rate_is_this_sessions_and_says_so():
         .endswith("16 runs in 15 s on 2 workers, 3840 runs/h")
     )
     assert _human(_result(0)).splitlines()[0].endswith("nothing left to run")
+
+
+def test_a_paired_campaign_summarises_its_arms_run_for_run(tmp_path):
+    from vic_drake.experiments.campaign import load_campaign_spec
+
+    campaigns = Path(__file__).resolve().parents[3] / "campaigns"
+    spec, _ = load_campaign_spec(campaigns / "robustness_online.yaml")
+    assert spec.paired and spec.grid_size == 2
+    rows = pd.DataFrame(
+        {
+            "run_id": [f"run_{i:05d}" for i in range(4)],
+            "index": range(4),
+            "status": ["ok"] * 4,
+            "error": [""] * 4,
+            "factor.controller": ["vs-vf", "vs-vf online"] * 2,
+            "peak_force_N": [9.0, 9.5, 10.0, 9.0],
+            "contact_loss_s": [0.0, 0.5, 0.0, 0.2],
+            "tank_min_J": [0.4] * 4,
+        }
+    )
+    summary = engine.summary_dict(spec, rows)
+    (pair,) = summary["paired"]
+    assert (pair["first"], pair["second"], pair["pairs"]) == (
+        "vs-vf",
+        "vs-vf online",
+        2,
+    )
+    page = summary_html(tmp_path, spec, rows, summary)
+    assert "Paired arms" in page and "<td>0 / 2 / 0 (p = " in page
+    unpaired = CampaignSpec(runs=4)
+    assert "paired" not in engine.summary_dict(unpaired, rows)

@@ -197,3 +197,46 @@ def test_missing_files_are_named(tmp_path):
     path.write_text("name: t\nbase_scenario: nowhere.yaml\n")
     with pytest.raises(VicDrakeError, match="nowhere.yaml"):
         load_campaign_spec(path)
+
+
+_PAIRED_FACTORS = (
+    "factors:\n"
+    "  - {field: controller, dist: grid, labels: [cf, vs-vf]}\n"
+    "  - {field: 'variations.sensor_faults.bias_N[2]', dist: normal, mean: 0, std: 1,"
+    " low: -3, high: 3}\n"
+    "  - {field: variations.motion.breathing.amplitude_m, dist: uniform, low: 0,"
+    " high: 0.01}\n"
+)
+
+
+@pytest.mark.parametrize("paired", [True, False])
+def test_paired_arms_share_every_draw_and_the_run_seed(tmp_path, paired):
+    body = ("paired: true\n" if paired else "") + _PAIRED_FACTORS
+    _, plans = _plans(_spec(tmp_path, body))
+    shared = (
+        "variations.sensor_faults.bias_N[2]",
+        "variations.motion.breathing.amplitude_m",
+    )
+    for k in range(0, 8, 2):
+        a, b = plans[k], plans[k + 1]
+        assert (a.factors["controller"], b.factors["controller"]) == ("cf", "vs-vf")
+        sa, sb = a.scenario(), b.scenario()
+        same = [a.factors[f] == b.factors[f] for f in shared]
+        same.append(
+            sa.variations.sensor_faults.seed == sb.variations.sensor_faults.seed
+        )
+        same.append(
+            sa.variations.motion.breathing.seed == sb.variations.motion.breathing.seed
+        )
+        assert all(same) if paired else not any(same)
+    # The next round draws anew.
+    assert plans[0].factors[shared[0]] != plans[2].factors[shared[0]]
+
+
+def test_paired_needs_a_grid(tmp_path):
+    path = _spec(
+        tmp_path,
+        "paired: true\nfactors:\n  - {field: seed, dist: uniform, low: 1, high: 9}\n",
+    )
+    with pytest.raises(VicDrakeError, match="paired needs a grid factor"):
+        load_campaign_spec(path)

@@ -7,6 +7,7 @@ import pytest
 
 from vic_drake.experiments.campaign.stats import (
     factor_effects,
+    paired_arms,
     per_controller,
     wilson_interval,
     worst_runs,
@@ -59,3 +60,39 @@ def test_factor_effects_and_worst_runs():
     assert cs["spearman"] == pytest.approx(1.0)
     worst = worst_runs(_rows(), n=3)
     assert list(worst["run_id"]) == ["run_00005", "run_00004", "run_00002"]
+
+
+def _paired_rows():
+    """Four rounds of two arms; round 3's second run failed."""
+    arm = ["map", "online"] * 4
+    return pd.DataFrame(
+        {
+            "index": range(8),
+            "status": ["ok"] * 7 + ["error"],
+            "factor.controller": arm,
+            "peak_force_N": [9.0, 9.5, 10.0, 9.0, 16.0, 14.0, 9.0, float("nan")],
+            "contact_loss_s": [0.0, 0.5, 0.0, 0.2, 0.0, 0.0, 0.3, 0.0],
+        }
+    )
+
+
+def test_paired_arms_compare_run_for_run():
+    (c,) = paired_arms(_paired_rows(), 2, 15.0)
+    assert (c["first"], c["second"], c["pairs"]) == ("map", "online", 3)
+    # Differences online - map over rounds 0-2: +0.5, -1.0, -2.0.
+    assert c["peak_force_diff_N_p50"] == pytest.approx(-1.0)
+    assert c["peak_force_diff_N_p10"] == pytest.approx(-1.8)
+    assert c["peak_force_diff_N_p90"] == pytest.approx(0.2)
+    # Contact loss: online alone in rounds 0 and 1; exact McNemar p = 0.5.
+    assert c["contact_loss"] == {
+        "both": 0,
+        "only_first": 0,
+        "only_second": 2,
+        "mcnemar_p": pytest.approx(0.5),
+    }
+    assert c["exceedance"]["only_first"] == 1 and c["exceedance"]["only_second"] == 0
+
+
+def test_paired_arms_need_a_grid_of_two_or_more():
+    assert paired_arms(_paired_rows(), 0, 15.0) == []
+    assert paired_arms(_paired_rows().iloc[:0], 2, 15.0) == []

@@ -49,7 +49,7 @@ from vic_drake.errors import VicDrakeError
 from vic_drake.experiments.campaign.plan import RunPlan, plan_campaign
 from vic_drake.experiments.campaign.run import failed_row
 from vic_drake.experiments.campaign.spec import CampaignSpec, load_campaign_spec
-from vic_drake.experiments.campaign.stats import per_controller
+from vic_drake.experiments.campaign.stats import paired_arms, per_controller
 from vic_drake.experiments.dask_cluster import dask_session
 from vic_drake.paths import (
     CAMPAIGN_SCENARIOS_DIR,
@@ -277,9 +277,10 @@ def _submit(
 
 
 def summary_dict(spec: CampaignSpec, rows: pd.DataFrame) -> dict:
-    """runs, finished, failed, nan_runs and per_controller of a campaign's rows."""
+    """runs, finished, failed, nan_runs and per_controller of a campaign's
+    rows; with ``paired``, also paired (:func:`~.stats.paired_arms`)."""
     status = rows["status"] if not rows.empty else pd.Series([], dtype=str)
-    return {
+    summary = {
         "runs": spec.runs,
         "finished": int(len(rows)),
         # Failed: raised or produced NaN (nan_runs counts the latter alone).
@@ -287,6 +288,9 @@ def summary_dict(spec: CampaignSpec, rows: pd.DataFrame) -> dict:
         "nan_runs": int((status == "nan").sum()),
         "per_controller": per_controller(rows, spec.force_limit_N),
     }
+    if spec.paired:
+        summary["paired"] = paired_arms(rows, spec.grid_size, spec.force_limit_N)
+    return summary
 
 
 __all__ = ["read_rows", "run_campaign", "summary_dict"]

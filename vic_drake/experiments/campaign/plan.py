@@ -1,8 +1,9 @@
 """The runs of a campaign: each run's sampled factors and its exact scenario.
 
-Run i draws from ``numpy.random.default_rng([seed, i])`` only, so its
-factors do not depend on the order runs finish in, on the number of
-workers, or on which runs a resumed campaign still has to do.
+Run i draws from ``numpy.random.default_rng([seed, i])`` only (with
+``paired``, from ``[seed, its grid round, 1]``), so its factors do not
+depend on the order runs finish in, on the number of workers, or on which
+runs a resumed campaign still has to do.
 """
 
 from __future__ import annotations
@@ -119,9 +120,12 @@ def apply_controller(scenario: Scenario, name: str) -> None:
 
 
 def _draw(spec: CampaignSpec, index: int) -> dict:
-    rng = np.random.default_rng([spec.seed, index])
-    out = {}
     cell = index % spec.grid_size if spec.grid_size else 0
+    if spec.paired:  # Every cell of a round draws alike: only the grid differs.
+        rng = np.random.default_rng([spec.seed, index // spec.grid_size, 1])
+    else:
+        rng = np.random.default_rng([spec.seed, index])
+    out = {}
     for f in spec.factors:
         if f.dist == "uniform":
             out[f.field] = float(rng.uniform(f.low, f.high))

@@ -100,6 +100,40 @@ def _table(header, body) -> str:
     return f"<table><tr>{head}</tr>{rows}</table>"
 
 
+def _paired_html(paired: list[dict], force_limit_N: float) -> str:
+    """The arms run for run (a paired campaign)."""
+
+    def counts(c: dict) -> str:
+        return (
+            f"{c['only_first']} / {c['only_second']} / {c['both']} "
+            f"(p = {_fmt(c['mcnemar_p'])})"
+        )
+
+    return "<h2>Paired arms (each pair under the same draws)</h2>" + _table(
+        [
+            "first arm",
+            "second arm",
+            "pairs",
+            "peak F, second minus first: p50 [p10, p90] (N)",
+            "contact loss: first only / second only / both (McNemar p)",
+            f"peak F > {force_limit_N:g} N: first only / second only / both",
+        ],
+        [
+            [
+                html.escape(c["first"]),
+                html.escape(c["second"]),
+                c["pairs"],
+                f"{_fmt(c['peak_force_diff_N_p50'])} "
+                f"[{_fmt(c['peak_force_diff_N_p10'])}, "
+                f"{_fmt(c['peak_force_diff_N_p90'])}]",
+                counts(c["contact_loss"]),
+                counts(c["exceedance"]),
+            ]
+            for c in paired
+        ],
+    )
+
+
 def summary_html(
     out: Path, spec: CampaignSpec, rows: pd.DataFrame, summary: dict
 ) -> str:
@@ -140,6 +174,8 @@ def summary_html(
             ],
         )
     )
+    if summary.get("paired"):
+        parts.append(_paired_html(summary["paired"], spec.force_limit_N))
     if not rows.empty:
         parts.append(_png(distribution_figure(rows, spec.force_limit_N)))
         effects = factor_effects(rows)

@@ -20,6 +20,12 @@ With ``population: true`` each run draws a synthetic patient
 (:func:`vic_drake.tissue.phantom.population.sample_patient`); with grid
 factors, every cell of one round of the grid gets the same patient, so
 controllers are compared on the same patients.
+
+With ``paired: true`` (it needs a grid factor) every cell of one round of
+the grid gets the same draws of every other factor too, and the same run
+seed (breathing, sensor noise, spikes and dropouts): the arms are compared
+under the same conditions, run for run (common random numbers). Without
+it, each run draws its own.
 """
 
 import dataclasses
@@ -104,6 +110,8 @@ class CampaignSpec:
     duration_s: float = 3.0  # Simulated time of each run, s.
     force_limit_N: float = 15.0  # The safety limit on the force on the patient, N.
     population: bool = False  # Each run draws a synthetic patient.
+    # The cells of a grid round share every other draw and the run seed.
+    paired: bool = False
     factors: list[Factor] = dataclasses.field(default_factory=list)
 
     def validate(self) -> "CampaignSpec":
@@ -126,6 +134,16 @@ class CampaignSpec:
             if f.field in seen:
                 raise VicDrakeError(f"{o}.factors: {f.field!r} appears twice")
             seen.add(f.field)
+        for key in ("population", "paired"):
+            if not isinstance(getattr(self, key), bool):
+                raise VicDrakeError(
+                    f"{o}.{key} must be true or false; got {getattr(self, key)!r}"
+                )
+        if self.paired and not self.grid_size:
+            raise VicDrakeError(
+                f"{o}.paired needs a grid factor (its cells are what is paired); "
+                "the factors have none"
+            )
         if self.grid_size and self.runs % self.grid_size:
             raise VicDrakeError(
                 f"{o}.runs ({self.runs}) must be a multiple of the grid's size "

@@ -111,6 +111,65 @@ def factor_effects(rows: pd.DataFrame, metric: str = "peak_force_N") -> list[dic
     return effects
 
 
+def _discordant(a: np.ndarray, b: np.ndarray) -> dict:
+    """Counts of a binary outcome over pairs, and the exact McNemar p."""
+    from scipy.stats import binomtest
+
+    only_a, only_b = int(np.sum(a & ~b)), int(np.sum(b & ~a))
+    n = only_a + only_b
+    p = binomtest(only_a, n, 0.5).pvalue if n else 1.0
+    return {
+        "both": int(np.sum(a & b)),
+        "only_first": only_a,
+        "only_second": only_b,
+        "mcnemar_p": float(p),
+    }
+
+
+def paired_arms(rows: pd.DataFrame, grid_size: int, force_limit_N: float) -> list[dict]:
+    """The arms compared run for run in a paired campaign (the runs of one grid
+    round share every draw: ``paired: true``), for each two arms in name order.
+
+    Pairs where either run failed are left out. For each: the pairs, the
+    peak force difference (second minus first: median, 10 and 90 %), and
+    the pairs where one arm, the other or both lost contact or exceeded the
+    force limit, with the exact McNemar p of the discordant pairs.
+    """
+    if rows.empty or grid_size < 2:
+        return []
+    ok = rows[rows["status"] == "ok"].assign(_pair=rows["index"] // grid_size)
+    arms = sorted(str(a) for a in ok["factor.controller"].unique())
+    out = []
+    for i, first in enumerate(arms):
+        for second in arms[i + 1 :]:
+            a = ok[ok["factor.controller"] == first].set_index("_pair")
+            b = ok[ok["factor.controller"] == second].set_index("_pair")
+            common = a.index.intersection(b.index)
+            if not common.size:
+                continue
+            a, b = a.loc[common], b.loc[common]
+            diff = (b["peak_force_N"] - a["peak_force_N"]).to_numpy(float)
+            out.append(
+                {
+                    "first": first,
+                    "second": second,
+                    "pairs": int(common.size),
+                    "peak_force_diff_N_p50": _stat(diff, np.median),
+                    "peak_force_diff_N_p10": _stat(diff, lambda v: np.quantile(v, 0.1)),
+                    "peak_force_diff_N_p90": _stat(diff, lambda v: np.quantile(v, 0.9)),
+                    "contact_loss": _discordant(
+                        (a["contact_loss_s"] > 0).to_numpy(),
+                        (b["contact_loss_s"] > 0).to_numpy(),
+                    ),
+                    "exceedance": _discordant(
+                        (a["peak_force_N"] > force_limit_N).to_numpy(),
+                        (b["peak_force_N"] > force_limit_N).to_numpy(),
+                    ),
+                }
+            )
+    return out
+
+
 def worst_runs(rows: pd.DataFrame, n: int = 10) -> pd.DataFrame:
     """The n worst runs: failed ones first, then by peak force, then contact loss."""
     if rows.empty:
@@ -122,4 +181,11 @@ def worst_runs(rows: pd.DataFrame, n: int = 10) -> pd.DataFrame:
     return order.drop(columns=["_failed", "_peak"]).head(n)
 
 
-__all__ = ["Z95", "factor_effects", "per_controller", "wilson_interval", "worst_runs"]
+__all__ = [
+    "Z95",
+    "factor_effects",
+    "paired_arms",
+    "per_controller",
+    "wilson_interval",
+    "worst_runs",
+]
