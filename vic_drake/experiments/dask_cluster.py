@@ -17,6 +17,7 @@ import logging
 import os
 import signal
 import threading
+import time
 
 from vic_drake.ctrl_c import hold_ctrl_c, release_ctrl_c
 from vic_drake.errors import VicDrakeError
@@ -156,6 +157,50 @@ def dask_session(workers: int | None, scheduler: str | None):
                     cluster.close()
 
 
+def map_on_cluster(
+    function, jobs, workers, scheduler, *, name: str, describe, on_done=None
+) -> list:
+    """``function(job)`` for each job on Dask (:func:`dask_session`), the
+    results in the jobs' order.
+
+    Args:
+        function: a module-level function (a worker imports it).
+        jobs: the jobs (plain data), or a callable that makes them from the
+            number of the cluster's workers.
+        name: the prefix of the tasks' keys.
+        describe: ``describe(i)`` names job i in an error, e.g. "the scan
+            true_map at 3 Hz".
+        on_done: called as ``on_done(i, result, done)`` as each job ends
+            (``done``: how many have); it may raise to stop the rest.
+
+    Raises:
+        VicDrakeError: the cluster cannot be had, or a job raised (named;
+            the jobs still to run are cancelled).
+        KeyboardInterrupt: on Ctrl-C, once the cluster is closed.
+    """
+    from distributed import as_completed
+
+    with dask_session(workers, scheduler) as (client, futures):
+        if callable(jobs):
+            jobs = jobs(max(1, len(client.scheduler_info()["workers"])))
+        stamp = time.time_ns()
+        for i, job in enumerate(jobs):
+            key = f"{name}-{i}-{stamp}"
+            futures[client.submit(function, job, pure=False, key=key)] = i
+        results = [None] * len(jobs)
+        for done, fut in enumerate(as_completed(list(futures)), start=1):
+            i = futures[fut]
+            try:
+                results[i] = fut.result()
+            except Exception as exc:  # noqa: BLE001 - e.g. KilledWorker.
+                raise VicDrakeError(
+                    f"{describe(i)} failed: {type(exc).__name__}: {exc}"
+                ) from None
+            if on_done is not None:
+                on_done(i, results[i], done)
+    return results
+
+
 def _workers(text: str) -> int:
     try:
         n = int(text)
@@ -188,7 +233,7 @@ def add_cluster_arguments(
     default = (
         "1: in this process, no cluster"
         if in_process_default
-        else ("the machine's cores")
+        else "the machine's cores"
     )
     where.add_argument(
         "--workers",
@@ -212,5 +257,6 @@ __all__ = [
     "ctrl_c_stops_once",
     "dask_client",
     "dask_session",
+    "map_on_cluster",
     "quiet_logs",
 ]

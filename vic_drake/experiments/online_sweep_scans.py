@@ -10,7 +10,6 @@ scheduler (:mod:`vic_drake.experiments.dask_cluster`).
 from __future__ import annotations
 
 import dataclasses
-import time
 
 from vic_drake.errors import VicDrakeError
 
@@ -72,37 +71,37 @@ def comparison_scan_in_child(scan: ComparisonScan) -> tuple[dict | None, str | N
 def run_on_cluster(jobs, workers, scheduler, on_scan=None) -> list[dict]:
     """The scores of each :class:`ComparisonScan` in ``jobs`` (in order), each
     made by :func:`comparison_scan_in_child` on a Dask cluster
-    (:func:`~vic_drake.experiments.dask_cluster.dask_session`).
+    (:func:`~vic_drake.experiments.dask_cluster.map_on_cluster`).
 
     Raises:
         VicDrakeError: the cluster cannot be had, or a scan failed (which,
             and why; the scans still to run are cancelled).
         KeyboardInterrupt: on Ctrl-C, once the cluster is closed.
     """
-    from distributed import as_completed
+    from vic_drake.experiments.dask_cluster import map_on_cluster
 
-    from vic_drake.experiments.dask_cluster import dask_session
+    def describe(i: int) -> str:
+        job = jobs[i]
+        at = "" if job.dither_hz is None else f" at {job.dither_hz:g} Hz"
+        return f"the scan {job.run}{at}"
 
-    results = [None] * len(jobs)
-    with dask_session(workers, scheduler) as (client, futures):
-        for i, job in enumerate(jobs):
-            key = f"compare-online-{i}-{job.run}-{time.time_ns()}"
-            futures[
-                client.submit(comparison_scan_in_child, job, pure=False, key=key)
-            ] = i
-        for fut in as_completed(list(futures)):
-            job = jobs[futures[fut]]
-            try:
-                scores, why = fut.result()
-            except Exception as exc:  # noqa: BLE001 - e.g. KilledWorker.
-                scores, why = None, f"{type(exc).__name__}: {exc}"
-            if why is not None:
-                at = "" if job.dither_hz is None else f" at {job.dither_hz:g} Hz"
-                raise VicDrakeError(f"the scan {job.run}{at} failed: {why}")
-            results[futures[fut]] = scores
-            if on_scan is not None:
-                on_scan(job.run, job.dither_hz)
-    return results
+    def done(i: int, result, _count: int) -> None:
+        why = result[1]
+        if why is not None:
+            raise VicDrakeError(f"{describe(i)} failed: {why}")
+        if on_scan is not None:
+            on_scan(jobs[i].run, jobs[i].dither_hz)
+
+    results = map_on_cluster(
+        comparison_scan_in_child,
+        jobs,
+        workers,
+        scheduler,
+        name="compare-online",
+        describe=describe,
+        on_done=done,
+    )
+    return [scores for scores, _ in results]
 
 
 __all__ = [

@@ -101,35 +101,27 @@ class CampaignResult:
 def _simulate_on_cluster(make_jobs, workers, scheduler, say) -> list:
     """The batches of ``make_jobs(cluster workers)`` simulated on Dask (a
     local cluster of ``workers`` processes, or the cluster at ``scheduler``),
-    in order.
+    in order (:func:`~vic_drake.experiments.dask_cluster.map_on_cluster`)."""
+    from vic_drake.experiments.dask_cluster import map_on_cluster
 
-    Raises:
-        VicDrakeError: the cluster cannot be had, or a batch failed (the
-            others are cancelled).
-        KeyboardInterrupt: on Ctrl-C, once the cluster is closed.
-    """
-    from distributed import as_completed
+    n_jobs = []
 
-    from vic_drake.experiments.dask_cluster import dask_session
+    def jobs(n_workers: int) -> list:
+        made = make_jobs(n_workers)
+        n_jobs.append(len(made))
+        return made
 
-    with dask_session(workers, scheduler) as (client, futures):
-        jobs = make_jobs(max(1, len(client.scheduler_info()["workers"])))
-        stamp = time.time_ns()
-        for k, job in enumerate(jobs):
-            key = f"palpation-batch-{k}-{stamp}"
-            futures[client.submit(_simulate_batch, job, pure=False, key=key)] = k
-        outs = [None] * len(jobs)
-        for done, fut in enumerate(as_completed(list(futures)), start=1):
-            k = futures[fut]
-            try:
-                outs[k] = fut.result()
-            except Exception as exc:  # noqa: BLE001 - e.g. KilledWorker.
-                raise VicDrakeError(
-                    f"palpation batch {k + 1} of {len(jobs)} failed: "
-                    f"{type(exc).__name__}: {exc}"
-                ) from None
-            say(f"batch {done} of {len(jobs)} done ({len(outs[k][0])} points)")
-    return outs
+    return map_on_cluster(
+        _simulate_batch,
+        jobs,
+        workers,
+        scheduler,
+        name="palpation-batch",
+        describe=lambda k: f"palpation batch {k + 1} of {n_jobs[0]}",
+        on_done=lambda k, out, done: say(
+            f"batch {done} of {n_jobs[0]} done ({len(out[0])} points)"
+        ),
+    )
 
 
 def run_campaign(

@@ -148,15 +148,18 @@ def paired_arms(rows: pd.DataFrame, grid_size: int, force_limit_N: float) -> lis
             if not common.size:
                 continue
             a, b = a.loc[common], b.loc[common]
-            diff = (b["peak_force_N"] - a["peak_force_N"]).to_numpy(float)
+            diff = _finite(b["peak_force_N"] - a["peak_force_N"])
+            p10, p50, p90 = (
+                np.quantile(diff, [0.1, 0.5, 0.9]) if diff.size else [math.nan] * 3
+            )
             out.append(
                 {
                     "first": first,
                     "second": second,
                     "pairs": int(common.size),
-                    "peak_force_diff_N_p50": _stat(diff, np.median),
-                    "peak_force_diff_N_p10": _stat(diff, lambda v: np.quantile(v, 0.1)),
-                    "peak_force_diff_N_p90": _stat(diff, lambda v: np.quantile(v, 0.9)),
+                    "peak_force_diff_N_p50": float(p50),
+                    "peak_force_diff_N_p10": float(p10),
+                    "peak_force_diff_N_p90": float(p90),
                     "contact_loss": _discordant(
                         (a["contact_loss_s"] > 0).to_numpy(),
                         (b["contact_loss_s"] > 0).to_numpy(),
