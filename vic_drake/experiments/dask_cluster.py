@@ -74,6 +74,10 @@ def dask_client(workers: int | None, scheduler: str | None):
                 threads_per_worker=1,
                 processes=True,
                 dashboard_address=":0",  # A free port: never clash with another.
+                # A worker's own log is no news: a task's failure comes back
+                # through its future, and a worker whose scheduler closes
+                # first (Ctrl-C) would print a heartbeat traceback.
+                silence_logs=logging.CRITICAL,
                 env={"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"},
             )
         client = Client(cluster)

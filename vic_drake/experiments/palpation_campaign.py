@@ -62,6 +62,16 @@ def _simulate_batch(args):
     return records, time.perf_counter() - start
 
 
+def _simulate_batch_in_child(args):
+    """:func:`_simulate_batch` in a process of its own, what a Dask worker
+    runs (:func:`~vic_drake.experiments.child_process.run_in_child`): the
+    worker stays free, so a cluster stopped by Ctrl-C closes without a busy
+    worker's complaint, and it does not keep each batch's Diagram."""
+    from vic_drake.experiments.child_process import run_in_child
+
+    return run_in_child(_simulate_batch, args)
+
+
 def _fit_batch(args):
     records, beta, lag_s, params = args
     return [fit_point(r, beta=beta, lag_s=lag_s, params=params) for r in records]
@@ -112,7 +122,7 @@ def _simulate_on_cluster(make_jobs, workers, scheduler, say) -> list:
         return made
 
     return map_on_cluster(
-        _simulate_batch,
+        _simulate_batch_in_child,
         jobs,
         workers,
         scheduler,
