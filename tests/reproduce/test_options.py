@@ -69,3 +69,36 @@ def test_stage_names_are_the_pipelines():
     from vic_drake.reproduce import STAGE_NAMES, STAGES
 
     assert tuple(name for name, _ in STAGES) == STAGE_NAMES
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"workers": 0}, "workers must be an integer >= 1 or None; got 0"),
+        ({"workers": True}, "workers must be an integer >= 1"),
+        ({"workers": 1.5}, "workers must be an integer >= 1"),
+        ({"scheduler": " "}, "scheduler must be an address such as tcp://"),
+        ({"workers": 2, "scheduler": "tcp://h:8786"}, "not both"),
+    ],
+)
+def test_options_reject_bad_cluster_settings(tmp_path, kwargs, message):
+    with pytest.raises(VicDrakeError, match=message):
+        ReproduceOptions(out_dir=tmp_path, **kwargs)
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--workers", "0"], "argument --workers: takes an integer >= 1"),
+        (
+            ["--workers", "2", "--scheduler", "tcp://h:8786"],
+            "argument --scheduler: not allowed with argument --workers",
+        ),
+    ],
+)
+def test_cli_bad_cluster_arguments_are_clean_errors(tmp_path, capsys, argv, message):
+    with pytest.raises(SystemExit) as exc:
+        main(["reproduce", "--out", str(tmp_path / "out"), *argv])
+    assert exc.value.code == 2
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()

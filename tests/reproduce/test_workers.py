@@ -1,4 +1,4 @@
-"""Ctrl-C stops a reproduce run and its worker pool within 2 s, and the
+"""Ctrl-C stops a reproduce run and its Dask workers within 2 s, and the
 interrupted run is marked incomplete."""
 
 import json
@@ -15,10 +15,23 @@ STOP_LIMIT_S = 2.0
 
 def _children(pid: int) -> list[int]:
     kids = []
-    for task in Path(f"/proc/{pid}/task").iterdir():
-        text = (task / "children").read_text().split()
-        kids.extend(int(k) for k in text)
+    try:
+        for task in Path(f"/proc/{pid}/task").iterdir():
+            text = (task / "children").read_text().split()
+            kids.extend(int(k) for k in text)
+    except FileNotFoundError:  # It has just ended.
+        pass
     return kids
+
+
+def _descendants(pid: int) -> list[int]:
+    """Every process below pid: the cluster's nannies and their workers."""
+    found, todo = [], [pid]
+    while todo:
+        kids = _children(todo.pop())
+        found += kids
+        todo += kids
+    return found
 
 
 def _alive(pid: int) -> bool:
@@ -52,17 +65,17 @@ def test_sigint_stops_the_scan_workers_within_2_s(tmp_path):
     )
     try:
         for line in proc.stderr:
-            if "worker process(es)" in line:
+            if "local Dask worker" in line:
                 break
         else:
             raise AssertionError("the scans stage never started")
         # Let the workers spawn and start their scans.
         deadline = time.monotonic() + 60
-        while len(_children(proc.pid)) < 1 and time.monotonic() < deadline:
+        while len(_descendants(proc.pid)) < 2 and time.monotonic() < deadline:
             time.sleep(0.2)
         time.sleep(4.0)
-        workers = _children(proc.pid)
-        assert workers, "no worker process started"
+        workers = _descendants(proc.pid)
+        assert len(workers) >= 2, f"no worker process started: {workers}"
         t0 = time.monotonic()
         proc.send_signal(signal.SIGINT)
         rest = proc.communicate(timeout=30)[1]

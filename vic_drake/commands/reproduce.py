@@ -13,6 +13,7 @@ from vic_drake.commands.common import (
     emit,
     parse_relaxation,
 )
+from vic_drake.experiments.dask_cluster import add_cluster_arguments
 from vic_drake.reproduce.stage_names import STAGE_NAMES
 
 #: Exit statuses of ``vic-drake reproduce`` (documented in its --help).
@@ -87,6 +88,7 @@ def register(subparsers) -> None:
         "every simulation of the run (default: vic_drake.tissue.DEFAULT_RELAXATION, "
         "0.08:22.9)",
     )
+    add_cluster_arguments(parser, "the scans and the compare-real re-runs")
     add_data_dir_option(parser)
     add_json_option(parser)
     parser.add_argument("--quiet", action="store_true", help="no progress on stderr")
@@ -145,6 +147,8 @@ def _run(args: argparse.Namespace) -> int:
         stages=stages,
         meshcat=args.meshcat,
         overwrite=args.overwrite,
+        workers=args.workers,
+        scheduler=args.scheduler,
         progress=progress,
         relaxation=None
         if args.relaxation is None

@@ -94,6 +94,18 @@ def dask_client(workers: int | None, scheduler: str | None):
     return client, cluster
 
 
+def check_scheduler(address: str) -> None:
+    """Connects to the Dask scheduler at ``address`` and disconnects: a
+    pipeline that uses it later fails at its start, not after its first
+    stages.
+
+    Raises:
+        VicDrakeError: the scheduler cannot be reached (after 20 s).
+    """
+    client, _ = dask_client(None, address)
+    client.close()
+
+
 @contextlib.contextmanager
 def ctrl_c_stops_once():
     """The first Ctrl-C raises KeyboardInterrupt; later ones are ignored.
@@ -156,9 +168,25 @@ def dask_session(workers: int | None, scheduler: str | None):
             with quiet_logs(interrupted):
                 for fut in futures:
                     fut.cancel()
+                if interrupted and cluster is not None:
+                    _kill_local_workers(cluster)
                 client.close()
                 if cluster is not None:
                     cluster.close()
+
+
+def _kill_local_workers(cluster) -> None:
+    """Kills a local cluster's worker processes (after Ctrl-C).
+
+    A worker busy in a task would be given about 2 s to end it before its
+    nanny kills it; the task's result is dropped anyway (docs/decisions.md,
+    "The reproduce scans on Dask").
+    """
+    for nanny in list(getattr(cluster, "workers", {}).values()):
+        pid = getattr(getattr(nanny, "process", None), "pid", None)
+        if pid:
+            with contextlib.suppress(OSError):  # It has just ended.
+                os.kill(pid, signal.SIGKILL)
 
 
 def map_on_cluster(
@@ -258,6 +286,7 @@ def add_cluster_arguments(
 
 __all__ = [
     "add_cluster_arguments",
+    "check_scheduler",
     "ctrl_c_stops_once",
     "dask_client",
     "dask_session",

@@ -30,6 +30,11 @@ class ReproduceOptions:
         relaxation: the relaxing tissue's branches in every simulation of the
             run (palpations, scans, compare-real); None (the default):
             :data:`vic_drake.tissue.DEFAULT_RELAXATION`.
+        workers: local Dask worker processes for the scans and the
+            compare-real re-runs (None: one per core; for compare-real, not
+            more than there are logs).
+        scheduler: the address of an existing Dask scheduler to run them
+            on instead (not with ``workers``).
         overwrite: replace a previous complete run in ``out_dir`` even when
             this run does not cover it (fewer stages, or no data where it had
             the data); without it such a run is refused before any work
@@ -45,9 +50,31 @@ class ReproduceOptions:
     progress: Callable[[str], None] = lambda message: None
     relaxation: RelaxationParams | None = None
     overwrite: bool = False
+    workers: int | None = None
+    scheduler: str | None = None
 
     def __post_init__(self):
         self.out_dir = Path(self.out_dir)
+        if self.workers is not None and (
+            isinstance(self.workers, bool)
+            or not isinstance(self.workers, int)
+            or self.workers < 1
+        ):
+            raise VicDrakeError(
+                f"workers must be an integer >= 1 or None; got {self.workers!r}"
+            )
+        if self.scheduler is not None and (
+            not isinstance(self.scheduler, str) or not self.scheduler.strip()
+        ):
+            raise VicDrakeError(
+                "scheduler must be an address such as tcp://host:8786 or None; "
+                f"got {self.scheduler!r}"
+            )
+        if self.workers is not None and self.scheduler is not None:
+            raise VicDrakeError(
+                "give workers (a local cluster) or scheduler (an existing one), "
+                "not both"
+            )
         if self.relaxation is not None and not isinstance(
             self.relaxation, RelaxationParams
         ):

@@ -110,6 +110,10 @@ def run_pipeline(ctx: RunContext) -> None:
             raise KeyboardInterrupt
 
 
+#: The stages that run on Dask (``options.workers`` / ``options.scheduler``).
+CLUSTER_STAGES = ("scans", "compare_real")
+
+
 def reproduce(options: ReproduceOptions) -> ReproduceResult:
     """Runs the reproduction; returns the claims and where everything is.
 
@@ -122,9 +126,17 @@ def reproduce(options: ReproduceOptions) -> ReproduceResult:
 
     Raises:
         VicDrakeError: the output folder cannot be used, or holds a complete
-            run that this one does not cover (checked before any work).
+            run that this one does not cover, or ``options.scheduler`` does
+            not answer (checked before any work).
     """
     data_dir = find_data_dir(options.data_dir)
+    if options.scheduler and (
+        options.stages is None or set(options.stages) & set(CLUSTER_STAGES)
+    ):
+        # Function-local: distributed (heavy).
+        from vic_drake.experiments.dask_cluster import check_scheduler
+
+        check_scheduler(options.scheduler)
     work = prepare_run_dir(
         options.out_dir,
         stages=options.stages,

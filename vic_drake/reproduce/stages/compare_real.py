@@ -9,11 +9,12 @@ from vic_drake.analysis.real_comparison import COMPARE_REAL_KEYS
 from vic_drake.reproduce.context import RunContext, StageSkipped
 from vic_drake.reproduce.report import ReportTable
 from vic_drake.reproduce.stages.real_scans import REAL_SCAN_LOGS
-from vic_drake.reproduce.workers import worker_pool
 
 
 def _compare_real_job(args):
-    """Worker: one real experiment re-run in simulation (module-level for spawn)."""
+    """Worker: one real experiment re-run in simulation (module-level: a Dask
+    worker imports it). It reads the log and the map from the data folder's
+    path, which a worker of an external cluster must see too."""
     # Function-local: pydrake (heavy).
     from vic_drake.experiments.compare_real import compare_real
 
@@ -35,26 +36,33 @@ def stage_compare_real(ctx: RunContext) -> dict:
     if ctx.options.quick:
         raise StageSkipped("full mode only (six more simulations of 20-26 s)")
     names = sorted(set(REAL_SCAN_LOGS.values()))
-    workers = max(1, min(len(names), os.cpu_count() or 1))
+    # Function-local: distributed (heavy).
+    from vic_drake.experiments.dask_cluster import map_on_cluster
+
+    opts = ctx.options
+    workers = opts.workers or max(1, min(len(names), os.cpu_count() or 1))
     out = {}
-    with worker_pool(workers) as pool:
-        jobs = {
-            name: pool.submit(
-                _compare_real_job,
-                (
-                    ctx.data_dir / "experiments" / name,
-                    ctx.data_dir,
-                    ctx.options.relaxation,
-                ),
-            )
+
+    def on_done(i, result, _done) -> None:
+        out[names[i]] = result
+        ctx.progress(
+            f"  {names[i]}: force RMSE {result[0]['force_rmse_N']:.2f} N, "
+            f"z RMSE {result[0]['z_rmse_mm']:.1f} mm"
+        )
+
+    map_on_cluster(
+        _compare_real_job,
+        [
+            (ctx.data_dir / "experiments" / name, ctx.data_dir, opts.relaxation)
             for name in names
-        }
-        for name, fut in jobs.items():
-            out[name] = fut.result()
-            ctx.progress(
-                f"  {name}: force RMSE {out[name][0]['force_rmse_N']:.2f} N, "
-                f"z RMSE {out[name][0]['z_rmse_mm']:.1f} mm"
-            )
+        ],
+        workers,
+        opts.scheduler,
+        name="reproduce-compare-real",
+        describe=lambda i: f"the re-run of {names[i]}",
+        on_done=on_done,
+    )
+    out = {name: out[name] for name in names}
     ctx.tables.append(
         ReportTable(
             "Real experiments re-run in simulation (measured map)",

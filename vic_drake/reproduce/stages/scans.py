@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import os
 import time
-from concurrent.futures import as_completed
 from dataclasses import replace
 
 from vic_drake.analysis import claims as claims_mod
@@ -18,7 +17,6 @@ from vic_drake.errors import VicDrakeError
 from vic_drake.paper import CONTROLLERS, DISTURBANCE_CONTROLLERS
 from vic_drake.reproduce.context import RunContext
 from vic_drake.reproduce.report import ReportTable
-from vic_drake.reproduce.workers import worker_pool
 
 #: Quick mode: the target starts QUICK_APPROACH_Z_M high (just above the
 #: surface at the start; see docs/decisions.md, "Quick mode") and scans
@@ -86,22 +84,24 @@ def scan_limits(scenario) -> claims_mod.ScanLimits:
 
 
 def _run_scan_job(args):
-    """Worker: one scan (module-level so a spawned process can run it)."""
+    """Worker: one scan on the phantom it is given (module-level: a Dask
+    worker imports it; it needs no data folder)."""
     # Function-local: pydrake (heavy).
     from vic_drake.experiments import run_scan
 
-    scenario, data_dir = args
-    return run_scan(scenario, data_dir=data_dir)
+    scenario, phantom = args
+    return run_scan(scenario, phantom=phantom)
 
 
 def stage_scans(ctx: RunContext) -> dict:
     """The four controllers nominal, VS-VF/CS/CF disturbed; logs; Fig. 6-7.
 
-    The scans run in worker processes (one per spare core) and, for the
-    nominal VS-VF scan, in this process.
+    The scans run on Dask: ``ctx.options.workers`` local workers (default
+    one per core) or the cluster of ``ctx.options.scheduler``.
     """
-    # Function-local: pydrake (heavy).
-    from vic_drake.experiments import run_scan
+    # Function-local: pydrake and distributed (heavy).
+    from vic_drake.experiments import load_scenario_phantom
+    from vic_drake.experiments.dask_cluster import map_on_cluster
     from vic_drake.experiments.rig_log import check_bag_scenario, write_scan_bag
     from vic_drake.scenario import save_scenario
 
@@ -122,28 +122,42 @@ def stage_scans(ctx: RunContext) -> dict:
         check_bag_scenario(scenario)
     logs = ctx.out_dir / "logs"
     logs.mkdir(parents=True, exist_ok=True)
-    local_key = ("nominal", "vs-vf")
-    workers = max(1, (os.cpu_count() or 1) - 1)
-    remote = [k for k in runs if k != local_key]
-    ctx.progress(
-        f"  {len(runs)} scans: {len(remote)} in {workers} worker process(es), "
-        f"{local_key[1]} {local_key[0]} in this one"
+    opts = ctx.options
+    workers = opts.workers or os.cpu_count() or 1
+    where = (
+        f"on the Dask scheduler {opts.scheduler}"
+        if opts.scheduler
+        else f"on {workers} local Dask worker(s)"
     )
+    ctx.progress(f"  {len(runs)} scans {where}")
+    # Loaded here once and sent with each scan: a worker needs no data folder.
+    phantoms = {}
+    for k in runs:
+        where_from = (scenarios[k].phantom.kind, scenarios[k].phantom.lookup)
+        if where_from not in phantoms:
+            phantoms[where_from] = load_scenario_phantom(
+                scenarios[k], data_dir=ctx.data_dir
+            )
     results = {}
-    with worker_pool(workers) as pool:
-        futures = {
-            pool.submit(_run_scan_job, (scenarios[k], ctx.data_dir)): k for k in remote
-        }
-        t0 = time.perf_counter()
-        results[local_key] = run_scan(scenarios[local_key], data_dir=ctx.data_dir)
-        _report_scan(
-            ctx, scenarios[local_key], results[local_key], len(results), len(runs)
-        )
-        for fut in as_completed(futures):
-            k = futures[fut]
-            results[k] = fut.result()
-            _report_scan(ctx, scenarios[k], results[k], len(results), len(runs))
-        ctx.progress(f"  scans done in {time.perf_counter() - t0:.1f} s")
+
+    def on_done(i, result, done) -> None:
+        results[runs[i]] = result
+        _report_scan(ctx, scenarios[runs[i]], result, done, len(runs))
+
+    t0 = time.perf_counter()
+    map_on_cluster(
+        _run_scan_job,
+        [
+            (s, phantoms[(s.phantom.kind, s.phantom.lookup)])
+            for s in (scenarios[k] for k in runs)
+        ],
+        workers,
+        opts.scheduler,
+        name="reproduce-scan",
+        describe=lambda i: f"the scan {scenarios[runs[i]].name}",
+        on_done=on_done,
+    )
+    ctx.progress(f"  scans done in {time.perf_counter() - t0:.1f} s")
     frames: dict = {"nominal": {}, "disturbance": {}}
     metrics: dict = {"nominal": {}, "disturbance": {}}
     timing = []
@@ -167,7 +181,7 @@ def stage_scans(ctx: RunContext) -> dict:
             "Simulated scans: timing",
             ["run", "simulated [s]", "wall [s]", "real-time factor"],
             timing,
-            f"{workers} worker process(es) plus the main process.",
+            f"The scans {where}.",
         )
     )
     return {
