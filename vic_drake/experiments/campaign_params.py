@@ -47,7 +47,7 @@ class CampaignParams:
             worker processes, so a calling script needs the ``if __name__ ==
             "__main__":`` guard. On 2 cores the gain is small (see
             docs/decisions.md, "Campaign workers"), hence 1 by default.
-        seed: seed of the sensor noise (batch k uses seed + k).
+        seed: seed of the sensor noise (point i of the grid: (seed, i)).
     """
 
     spacing_m: float = 0.01

@@ -16,10 +16,10 @@ fresh Context (:meth:`IndenterBank.set_points`).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
-from pydrake.common import RandomDistribution, RandomGenerator
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import (
     PdControllerGains,
@@ -28,11 +28,7 @@ from pydrake.multibody.tree import (
     UnitInertia,
 )
 from pydrake.systems.framework import Diagram, DiagramBuilder
-from pydrake.systems.primitives import (
-    ConstantVectorSource,
-    LogVectorOutput,
-    RandomSource,
-)
+from pydrake.systems.primitives import ConstantVectorSource, LogVectorOutput
 
 from vic_drake.errors import VicDrakeError
 from vic_drake.paper import GRAVITY_M_PER_S2
@@ -44,6 +40,7 @@ from vic_drake.systems.indenter import (
     PalpationTarget,
     SensorParams,
 )
+from vic_drake.systems.noise_table import NoiseTable
 from vic_drake.tissue.relaxation import DEFAULT_RELAXATION, RelaxationParams
 
 
@@ -56,6 +53,7 @@ class IndenterBank:
     tissue: HuntCrossleyIndentation
     sensor: LaggedForceSensor
     target: PalpationTarget
+    noise: NoiseTable
     state_logger: object
     force_logger: object
     target_logger: object
@@ -63,16 +61,22 @@ class IndenterBank:
     n: int
 
     def set_points(
-        self, root_context, *, surface_z, kappa, lam, start_z, seed=None
+        self, root_context, *, surface_z, kappa, lam, start_z, seed=None, ids=None
     ) -> None:
         """Writes the tissue and the start height of every indenter.
 
         The indenters start at rest at ``start_z``; arrays of shape (n,).
-        With ``seed``, the sensor noise is reseeded first (this resets every
-        random state and parameter, hence it comes before the writes).
+        With ``seed``, indenter i's sensor noise is drawn from ``(seed,
+        ids[i])`` (``ids`` default: 0..n-1), so a point's noise does not
+        depend on the other points of its batch
+        (:class:`~vic_drake.systems.noise_table.NoiseTable`).
         """
         if seed is not None:
-            self.diagram.SetRandomContext(root_context, RandomGenerator(int(seed)))
+            self.noise.set_noise(
+                self.noise.GetMyMutableContextFromRoot(root_context),
+                seed=int(seed),
+                ids=np.arange(self.n) if ids is None else ids,
+            )
         self.tissue.set_tissue(
             self.tissue.GetMyMutableContextFromRoot(root_context),
             surface_z=surface_z,
@@ -152,8 +156,14 @@ def MakeIndenterDiagram(
         "ft_sensor",
         LaggedForceSensor(n, sensor, indenter_mass_kg=indenter.indenter_mass_kg),
     )
+    # Samples for the longest palpation simulate_palpations runs (longest
+    # approach, then the palpation), and a few periods more.
+    samples = (
+        math.ceil((palpation.max_approach_s + palpation.duration_s) / sensor.period_s)
+        + 4
+    )
     noise = builder.AddNamedSystem(
-        "sensor_noise", RandomSource(RandomDistribution.kGaussian, n, sensor.period_s)
+        "sensor_noise", NoiseTable(n, sensor.period_s, samples)
     )
     target = builder.AddNamedSystem(
         "palpation_target", PalpationTarget(n, palpation, period_s=sensor.period_s)
@@ -215,6 +225,7 @@ def MakeIndenterDiagram(
         tissue=tissue,
         sensor=force_sensor,
         target=target,
+        noise=noise,
         state_logger=state_logger,
         force_logger=force_logger,
         target_logger=target_logger,

@@ -46,7 +46,7 @@ def grid_points(region_m, spacing_m: float) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _simulate_batch(args):
-    x, y, s, k, lam, beta, params, seed, relaxation = args
+    x, y, s, k, lam, beta, params, seed, relaxation, ids = args
     start = time.perf_counter()
     records = simulate_palpations(
         x,
@@ -58,6 +58,7 @@ def _simulate_batch(args):
         params=params,
         seed=seed,
         relaxation=relaxation,
+        ids=ids,
     )
     return records, time.perf_counter() - start
 
@@ -183,10 +184,11 @@ def run_campaign(
                 truth.lam[c],
                 beta,
                 params,
-                params.seed + k,
+                params.seed,
                 relaxation,
+                c,  # The points' ids: their noise does not follow the split.
             )
-            for k, c in enumerate(chunks)
+            for c in chunks
         ]
 
     t0 = time.perf_counter()

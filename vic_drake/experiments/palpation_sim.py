@@ -53,6 +53,7 @@ def simulate_palpations(
     params: CampaignParams,
     seed: int = 0,
     relaxation: RelaxationParams | None = DEFAULT_RELAXATION,
+    ids=None,
 ) -> list[SimulatedPalpation]:
     """Palpates n points at once in one indenter-bank diagram.
 
@@ -63,6 +64,10 @@ def simulate_palpations(
         beta: Hunt-Crossley exponent.
         params: the campaign (palpation, indenter, sensor).
         seed: seed of the sensor noise.
+        ids: (n,) integer ids of the points (default 0..n-1): point i's
+            sensor noise is drawn from (seed, ids[i]) alone, so a point
+            palpated with other points, or in another batch, reads the same
+            noise.
         relaxation: the tissue's relaxation (:mod:`vic_drake.tissue.relaxation`,
             any number of branches); None: plain Hunt-Crossley tissue (the
             one-branch element with g = 0).
@@ -96,6 +101,7 @@ def simulate_palpations(
         lam=lam,
         start_z=surface_z + pal.start_clearance_m,
         seed=seed,
+        ids=_point_ids(ids, n),
     )
     bank.tissue.set_relaxation(
         bank.tissue.GetMyMutableContextFromRoot(context), relaxation
@@ -135,6 +141,18 @@ def simulate_palpations(
             )
         )
     return records
+
+
+def _point_ids(ids, n: int) -> np.ndarray:
+    if ids is None:
+        return np.arange(n)
+    out = np.atleast_1d(np.asarray(ids))
+    if out.shape != (n,) or not np.issubdtype(out.dtype, np.integer) or np.any(out < 0):
+        raise VicDrakeError(
+            "simulate_palpations: ids must be one integer >= 0 per point "
+            f"({n} points); got {ids!r}"
+        )
+    return out
 
 
 __all__ = ["SimulatedPalpation", "simulate_palpations"]
