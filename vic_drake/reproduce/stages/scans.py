@@ -130,14 +130,15 @@ def stage_scans(ctx: RunContext) -> dict:
         else f"on {workers} local Dask worker(s)"
     )
     ctx.progress(f"  {len(runs)} scans {where}")
-    # Loaded here once and sent with each scan: a worker needs no data folder.
-    phantoms = {}
-    for k in runs:
-        where_from = (scenarios[k].phantom.kind, scenarios[k].phantom.lookup)
-        if where_from not in phantoms:
-            phantoms[where_from] = load_scenario_phantom(
-                scenarios[k], data_dir=ctx.data_dir
-            )
+    phantoms = {}  # Loaded once here and sent with each scan: no data on a worker.
+
+    def phantom_of(scenario):
+        key = (scenario.phantom.kind, scenario.phantom.lookup)
+        if key not in phantoms:
+            phantoms[key] = load_scenario_phantom(scenario, data_dir=ctx.data_dir)
+        return phantoms[key]
+
+    jobs = [(scenarios[k], phantom_of(scenarios[k])) for k in runs]
     results = {}
 
     def on_done(i, result, done) -> None:
@@ -147,10 +148,7 @@ def stage_scans(ctx: RunContext) -> dict:
     t0 = time.perf_counter()
     map_on_cluster(
         _run_scan_job,
-        [
-            (s, phantoms[(s.phantom.kind, s.phantom.lookup)])
-            for s in (scenarios[k] for k in runs)
-        ],
+        jobs,
         workers,
         opts.scheduler,
         name="reproduce-scan",
