@@ -150,3 +150,58 @@ def test_a_simulated_scan_on_its_own_map_meets_the_scan_targets(
     assert result["samples"] > 4000
     assert result["kappa_rel_err_median"] <= 0.20
     assert result["kappa_corr"] >= 0.8
+
+
+@pytest.fixture(scope="module")
+def simulated_palpation_bags(tmp_path_factory):
+    """10 s palpations at 1 and 2.5 Hz of one point of the synthetic chest
+    (relaxing tissue, sensor noise and lag), written as the rig's bags."""
+    import numpy as np
+
+    from vic_drake.experiments import CampaignParams, simulate_palpations
+    from vic_drake.experiments.rig_log import write_palpation_bag
+    from vic_drake.systems.indenter import PalpationParams
+    from vic_drake.tissue import load_phantom
+
+    phantom = load_phantom("synthetic")
+    x, y = np.array([-0.05]), np.array([-0.36])
+    truth = phantom.sample(x, y)
+    folder = tmp_path_factory.mktemp("palpations")
+    bags = {}
+    for f in (1.0, 2.5):
+        palpation = PalpationParams(frequency_hz=f, duration_s=10.0)
+        (record,) = simulate_palpations(
+            x,
+            y,
+            surface_z=truth.surface_z_m,
+            kappa=truth.kappa,
+            lam=truth.lam,
+            beta=phantom.beta,
+            params=CampaignParams(palpation=palpation),
+            seed=1,
+        )
+        bags[f] = write_palpation_bag(
+            record, folder / f"{f:g}hz", surface_z_m=float(truth.surface_z_m[0])
+        )
+    return bags
+
+
+@pytest.mark.parametrize("frequency_hz", [1.0, 2.5])
+@pytest.mark.parametrize("method", ["rls", "ekf"])
+def test_a_simulated_palpation_meets_the_palpation_targets(
+    capsys, simulated_palpation_bags, frequency_hz, method
+):
+    """Within 10 % of the whole log's fit in <= 2 s and close to it, on a
+    palpation of the project's relaxing tissue. The real 1 Hz log takes
+    3.45 s: its tissue softens more than this one in its first seconds
+    (docs/decisions.md, "The 1 Hz palpation's 2 s target is out of reach
+    for an estimator of the current tissue"). No real data needed."""
+    bag = simulated_palpation_bags[frequency_hz]
+    status, out, err = run(
+        capsys, ["estimate-online", bag, "--method", method, "--json"]
+    )
+    assert status == 0, err
+    result = json.loads(out)
+    assert set(result) == KEYS and result["kappa_corr"] is None
+    assert result["convergence_s"] is not None and result["convergence_s"] <= 2.0
+    assert result["kappa_rel_err_median"] <= 0.05

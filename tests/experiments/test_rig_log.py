@@ -90,3 +90,26 @@ def test_a_log_that_is_not_one_row_per_tick_cannot_be_a_bag():
     s = replace(s, logging=replace(s.logging, period_s=0.01))
     with pytest.raises(VicDrakeError, match="one row per controller tick"):
         check_bag_scenario(s)
+
+
+def test_a_simulated_palpation_bag_reads_back_as_the_record(tmp_path):
+    from vic_drake.estimation.palpation import PalpationData
+    from vic_drake.experiments import CampaignParams, simulate_palpations
+    from vic_drake.experiments.rig_log import write_palpation_bag
+    from vic_drake.systems.indenter import PalpationParams
+
+    params = CampaignParams(palpation=PalpationParams(duration_s=1.0))
+    (record,) = simulate_palpations(
+        [0.0], [0.0], surface_z=[0.1], kappa=[2.0e5], lam=[5.0], beta=1.35,
+        params=params, seed=4,
+    )  # fmt: skip
+    bag = read_bag(write_palpation_bag(record, tmp_path / "bag", surface_z_m=0.1))
+    assert bag.attrs["layout"] == "palpation"
+    data = PalpationData.from_frame(bag)
+    np.testing.assert_allclose(data.t_s, record.t_s, atol=1e-9)
+    np.testing.assert_array_equal(data.z_m, record.z_m)
+    np.testing.assert_array_equal(data.force_N, record.force_N)  # Pressing: > 0.
+    assert data.surface_z_m == 0.1 and record.force_N.max() > 1.0
+    with pytest.raises(VicDrakeError, match="2 samples or more"):
+        one = replace(record, t_s=record.t_s[:1], z_m=record.z_m[:1])
+        write_palpation_bag(one, tmp_path / "b", surface_z_m=0.1)

@@ -9,6 +9,8 @@ tick). :func:`rig_log_rows` turns a :class:`~vic_drake.experiments.scan_run.Scan
 rows: the 31-column ``/adaptive_stiffness_data`` layout for the VS
 controllers, the 9-column ``/data_control`` layout for CS and CF, as on the
 rig; :func:`write_scan_bag` writes them as a ROS 2 bag.
+:func:`write_palpation_bag` writes a simulated palpation in the rig's
+palpation layout.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ import os
 from pathlib import Path
 from typing import NamedTuple
 
+import numpy as np
 import pandas as pd
 
 from vic_drake.analysis.rig_layout import (
@@ -26,6 +29,7 @@ from vic_drake.analysis.rig_layout import (
     scan_log_rows,
 )
 from vic_drake.errors import VicDrakeError
+from vic_drake.realdata import PALPATION_COLUMNS
 from vic_drake.realdata_write import write_bag
 from vic_drake.systems.signals import CONTACT_FIELDS, TICK_RECORD_FIELDS
 
@@ -164,12 +168,42 @@ def write_scan_bag(result, path: str | os.PathLike) -> Path:
     return write_bag(rig_log_rows(result), path)
 
 
+def palpation_log_rows(record, *, surface_z_m: float) -> pd.DataFrame:
+    """A simulated palpation (a
+    :class:`~vic_drake.experiments.palpation_sim.SimulatedPalpation`) in the
+    rig's 6-column palpation layout (:data:`vic_drake.realdata.PALPATION_COLUMNS`):
+    the point's surface height ``surface_z_m`` in every row, the tip's
+    velocity by central differences, the force as the sensor reads it
+    (negative: pressing)."""
+    t = np.asarray(record.t_s, float)
+    z = np.asarray(record.z_m, float)
+    if t.size < 2:
+        raise VicDrakeError(f"a palpation log needs 2 samples or more; got {t.size}")
+    rows = {
+        "t_s": t,
+        "surface_z_m": np.full(t.size, float(surface_z_m)),
+        "z_target_m": np.asarray(record.z_target_m, float),
+        "z_m": z,
+        "vz_m_per_s": np.gradient(z, t),
+        "force_z_N": -np.asarray(record.force_N, float),
+    }
+    return pd.DataFrame({c: rows[c] for c in PALPATION_COLUMNS})
+
+
+def write_palpation_bag(record, path: str | os.PathLike, *, surface_z_m: float) -> Path:
+    """Writes a simulated palpation as the rig's ROS 2 bag
+    (:func:`palpation_log_rows`); returns the folder."""
+    return write_bag(palpation_log_rows(record, surface_z_m=surface_z_m), path)
+
+
 __all__ = [
     "RIG_GROUPS",
     "RigGroup",
     "check_bag_scenario",
+    "palpation_log_rows",
     "rig_frame",
     "rig_log_ports",
     "rig_log_rows",
+    "write_palpation_bag",
     "write_scan_bag",
 ]
