@@ -16,8 +16,9 @@ SIM_PALPATION_FREQUENCIES_HZ = (1.0, 2.0, 2.5)
 SIM_PALPATION_POINT_M = (-0.05, -0.36)
 
 
-def _simulate(ctx, phantom, truth, xy, *, freqs, duration, relaxation, tag) -> dict:
-    """Simulated palpations at each frequency -> {name: (PalpationData, lag_s)}."""
+def _simulate(ctx, phantom, truth, xy, *, freqs, duration, relaxation, tag) -> tuple:
+    """Simulated palpations at each frequency -> ({name: (PalpationData,
+    lag_s)}, {frequency: its bag folder}: the relaxing tissue's only)."""
     # Function-local: the campaign and the indenter pull in pydrake (heavy).
     from vic_drake.estimation.palpation import PalpationData
     from vic_drake.experiments import CampaignParams, simulate_palpations
@@ -25,7 +26,7 @@ def _simulate(ctx, phantom, truth, xy, *, freqs, duration, relaxation, tag) -> d
 
     law = "hc" if relaxation is None else "relaxing"
     x, y = xy
-    logs = {}
+    logs, bags = {}, {}
     for k, f in enumerate(freqs):
         params = CampaignParams(
             palpation=PalpationParams(frequency_hz=f, duration_s=duration), seed=k
@@ -63,6 +64,14 @@ def _simulate(ctx, phantom, truth, xy, *, freqs, duration, relaxation, tag) -> d
                 "relaxation": relaxation,
             },
         )
+        if tag == "":  # The relaxing tissue's palpations also as the rig's bags.
+            from vic_drake.experiments.rig_log import write_palpation_bag
+
+            bags[f] = write_palpation_bag(
+                rec,
+                ctx.out_dir / "logs" / f"palpation_sim_{f:g}hz_bag",
+                surface_z_m=float(truth.surface_z_m[0]),
+            )
         data = PalpationData(
             t_s=rec.t_s,
             z_m=rec.z_m,
@@ -71,7 +80,7 @@ def _simulate(ctx, phantom, truth, xy, *, freqs, duration, relaxation, tag) -> d
             z_target_m=rec.z_target_m,
         )
         logs[f"sim_{f:g}hz"] = (data, lag)
-    return logs
+    return logs, bags
 
 
 def _errors(fits: dict, kappa: float, kappa_relaxed: float, lam: float) -> dict:
@@ -118,8 +127,11 @@ def stage_offline_sim(ctx: RunContext) -> dict:
     relaxation = ctx.options.relaxation or DEFAULT_RELAXATION
     kappa_relaxed = relaxation.long_term_fraction * kappa
     run = dict(freqs=freqs, duration=duration)
-    logs = _simulate(ctx, phantom, truth, xy, relaxation=relaxation, tag="", **run)
+    logs, bags = _simulate(
+        ctx, phantom, truth, xy, relaxation=relaxation, tag="", **run
+    )
     out = offline_fits(ctx, logs, "sim")
+    out["palpation_bags"] = bags  # Replayed by the online stage.
     out["truth"] = {
         "kappa": kappa,
         "kappa_relaxed": kappa_relaxed,
@@ -133,7 +145,7 @@ def stage_offline_sim(ctx: RunContext) -> dict:
     out["c2_relaxing"] = {"value": c2, "pass": c2_pass}
 
     ctx.progress("  control: the same palpations on plain Hunt-Crossley tissue")
-    control = _simulate(ctx, phantom, truth, xy, relaxation=None, tag="_hc", **run)
+    control, _ = _simulate(ctx, phantom, truth, xy, relaxation=None, tag="_hc", **run)
     decay, fits = {}, {}
     for name, (data, lag) in control.items():
         aligned = shift(data, lag)

@@ -3,8 +3,10 @@
 With the paper's data: over its palpation logs (reference: the offline fit
 of the whole log) and its VS scan logs (reference: the map values the
 controller logged), as ``vic-drake estimate-online`` does. On every run:
-over this run's simulated VS-VF scan, against the phantom's true kappa
-under the probe. A table of the scores and a figure of kappa-hat.
+over this run's simulated palpations (the ``offline_sim`` stage's bags,
+against their own whole-log fit) and its simulated VS-VF scan, against the
+phantom's true kappa under the probe. A table of the scores and a figure
+of kappa-hat.
 """
 
 from __future__ import annotations
@@ -93,6 +95,14 @@ def stage_online(ctx: RunContext) -> dict:
                 results[(name, method)] = replay.summary
                 rows.append(_row(name, method, replay.summary))
                 traces[(name, method)] = replay
+    # This run's simulated palpations, as their bags (what estimate-online reads).
+    bags = (ctx.results.get("offline_sim") or {}).get("palpation_bags", {})
+    for f, path in sorted(bags.items()):
+        name = f"simulated palpation {f:g} Hz ({ctx.phantom_kind})"
+        for method in ONLINE_METHODS:
+            replay = replay_online(path, params=OnlineEstimatorParams(method=method))
+            results[(name, method)] = replay.summary
+            rows.append(_row(name, method, replay.summary))
     frames = (ctx.results.get("scans") or {}).get("frames", {})
     sim = frames.get("nominal", {}).get("vs-vf")
     sim_traces = {}
@@ -108,7 +118,8 @@ def stage_online(ctx: RunContext) -> dict:
             sim_traces[method] = (trace, kappa)
     if not rows:
         raise StageSkipped(
-            "no real logs and no simulated VS-VF scan (run the scans stage too)"
+            "no real logs and no simulated palpation or VS-VF scan (run the "
+            "offline_sim or scans stage too)"
         )
     ctx.tables.append(
         ReportTable(
@@ -123,7 +134,8 @@ def stage_online(ctx: RunContext) -> dict:
                 "tick p99 [us]",
             ],
             rows,
-            "Palpations against the offline fit of the whole log; real VS scans "
+            "Palpations (real, and this run's simulated ones) against the offline "
+            "fit of the whole log; real VS scans "
             "against the map values the controller logged; the simulated scan "
             "against the phantom's true kappa under the probe. Convergence: from "
             "first contact until kappa-hat stays within 10 % ('-': never). The "
