@@ -20,13 +20,9 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
-import subprocess
 import sys
-import tempfile
-import time
 
-from common import HERE, checkout_environment, is_checkout, versions
+from common import HERE, is_checkout, run_timed, versions
 
 DEFAULT = [
     "nominal_vs_vf_synthetic",
@@ -41,21 +37,8 @@ DEFAULT = [
 def run(tree: str, args: list[str]) -> tuple[float, float, dict]:
     """(wall s, peak RSS MB of any process of the command, its JSON)."""
     command = [sys.executable, "-m", "vic_drake.cli", "compare-online", *args, "--json"]
-    with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
-        t0 = time.perf_counter()
-        proc = subprocess.Popen(
-            command, env=checkout_environment(tree), stdout=out, stderr=err, cwd=tree
-        )
-        # wait4, not proc.wait: its rusage's ru_maxrss (kB) is the largest of
-        # the command's and of every descendant it waited for.
-        _, status, usage = os.wait4(proc.pid, 0)
-        wall = time.perf_counter() - t0
-        proc.returncode = os.waitstatus_to_exitcode(status)
-        out.seek(0)
-        err.seek(0)
-        if proc.returncode != 0:
-            sys.exit(f"the run with {tree} failed:\n{err.read().decode()[-2000:]}")
-        return wall, usage.ru_maxrss / 1024, json.loads(out.read())
+    out, wall, peak = run_timed(tree, command, cwd=tree)
+    return wall, peak, json.loads(out)
 
 
 def main() -> None:

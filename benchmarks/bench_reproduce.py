@@ -19,12 +19,11 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import subprocess
 import sys
 import tempfile
 import time
 
-from common import HERE, checkout_environment, is_checkout, versions
+from common import HERE, is_checkout, run_timed, versions
 
 
 def _in_process(args) -> None:
@@ -52,27 +51,15 @@ def _in_process(args) -> None:
 
 
 def _one_run(tree: str, args, out: str) -> tuple[dict, float, float]:
-    """(the run's --json summary, wall s, peak RSS of its largest process, MB:
-    Linux's wait4 gives the most of the run's process and of every process
-    below it that was waited for, its Dask workers included)."""
+    """(the run's --json summary, wall s, peak RSS of its largest process,
+    MB, its Dask workers included: :func:`common.run_timed`)."""
     command = [sys.executable, "-m", "vic_drake.cli", "reproduce", "--out", out]
     command += ["--json", "--allow-fail", "--overwrite"]
     command += [] if args.full else ["--quick"]
     command += ["--stages", args.stages] if args.stages else []
     command += ["--phantom", args.phantom]
-    with tempfile.TemporaryFile() as stdout, tempfile.TemporaryFile() as stderr:
-        t0 = time.perf_counter()
-        proc = subprocess.Popen(
-            command, env=checkout_environment(tree), stdout=stdout, stderr=stderr
-        )
-        _, status, usage = os.wait4(proc.pid, 0)
-        wall = time.perf_counter() - t0
-        proc.returncode = os.waitstatus_to_exitcode(status)
-        stdout.seek(0)
-        stderr.seek(0)
-        if proc.returncode != 0:
-            sys.exit(f"the run with {tree} failed:\n{stderr.read()[-2000:].decode()}")
-        return json.loads(stdout.read()), wall, usage.ru_maxrss / 1024
+    out_text, wall, peak = run_timed(tree, command)
+    return json.loads(out_text), wall, peak
 
 
 def _interleaved(args) -> None:

@@ -13,6 +13,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import time
 
 import numpy as np
 
@@ -90,6 +91,25 @@ def run_in_checkout(tree: str, command: list[str]) -> subprocess.CompletedProces
     if done.returncode != 0:
         sys.exit(f"the run with {tree} failed:\n{done.stderr[-2000:]}")
     return done
+
+
+def run_timed(tree: str, command: list[str], cwd=None) -> tuple[str, float, float]:
+    """Runs ``command`` in ``tree``'s environment (:func:`checkout_environment`);
+    exits on failure. Returns (its stdout, wall s, peak RSS MB): wait4's
+    ru_maxrss, the largest of the command's and of every process below it
+    that was waited for (a local Dask cluster's workers included)."""
+    with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
+        t0 = time.perf_counter()
+        proc = subprocess.Popen(
+            command, env=checkout_environment(tree), stdout=out, stderr=err, cwd=cwd
+        )
+        _, status, usage = os.wait4(proc.pid, 0)
+        wall = time.perf_counter() - t0
+        out.seek(0)
+        err.seek(0)
+        if os.waitstatus_to_exitcode(status) != 0:
+            sys.exit(f"the run with {tree} failed:\n{err.read().decode()[-2000:]}")
+        return out.read().decode(), wall, usage.ru_maxrss / 1024
 
 
 def run_sections(sections: dict, doc: str) -> None:

@@ -30,39 +30,23 @@ def test_campaign_params_reject_bad_values():
     with pytest.raises(VicDrakeError, match="lag_samples"):
         SensorParams(lag_samples=-1)
     with pytest.raises(VicDrakeError, match="common"):
-        simulate_palpations(
-            [0.0, 0.01],
-            [0.0],
-            surface_z=[0.1],
-            kappa=[1.0],
-            lam=[1.0],
-            beta=BETA,
-            params=CampaignParams(),
-        )
+        _palpate(x=[0.0, 0.01])
     with pytest.raises(VicDrakeError, match="finite"):
-        simulate_palpations(
-            [0.0],
-            [0.0],
-            surface_z=[np.nan],
-            kappa=[1.0],
-            lam=[1.0],
-            beta=BETA,
-            params=CampaignParams(),
-        )
+        _palpate(surface_z=[np.nan])
     for ids in ([1, 2], [-1], [0.5]):
         with pytest.raises(
             VicDrakeError, match=r"ids must be one integer >= 0 per point \(1 points\)"
         ):
-            simulate_palpations(
-                [0.0],
-                [0.0],
-                surface_z=[0.1],
-                kappa=[1.0],
-                lam=[1.0],
-                beta=BETA,
-                params=CampaignParams(),
-                ids=ids,
-            )
+            _palpate(ids=ids)
+
+
+def _palpate(**overrides):
+    """simulate_palpations of one point, with arguments replaced."""
+    args = dict(x=[0.0], y=[0.0], surface_z=[0.1], kappa=[1.0], lam=[1.0])
+    args.update(beta=BETA, params=CampaignParams())
+    args.update(overrides)
+    x, y = args.pop("x"), args.pop("y")
+    return simulate_palpations(x, y, **args)
 
 
 @pytest.mark.parametrize("x", [-0.09, -0.115])  # soft tissue; on a rib
