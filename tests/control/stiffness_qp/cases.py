@@ -37,3 +37,17 @@ def random_problems(draw):
         draw(vec(0.03)), draw(vec(0.05)), damping, f_ref, f_min,
         draw(st.floats(0.4, 1.2)), draw(st.floats(5e-4, 4e-3)), qp, TANK,
     )  # fmt: skip
+
+
+def tank_row_resolvable(p, tol_W: float = 1e-6) -> bool:
+    """Whether the tank row can change a'K by tol_W or more over the
+    stiffness box (or is absent). Rows below that (e e_dot near underflow,
+    e.g. a = -1.7e-310 with a bound of -1.7e-308, i.e. K_z <= 100) are honoured
+    exactly by the exact solver and are below any iterative solver's
+    tolerance, so the two may differ in K while both are feasible to
+    tol_W."""
+    span = sum(
+        abs(a) * (hi - lo)
+        for a, lo, hi in zip(p.tank_a, p.stiffness_min, p.stiffness_max)
+    )
+    return span == 0.0 or span >= tol_W
