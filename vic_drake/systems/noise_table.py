@@ -31,9 +31,9 @@ def channel_noise(seed: int, ids, samples: int) -> np.ndarray:
 
 class NoiseTable(LeafSystem):
     """Output ``noise`` (n): row k of a (samples, n) table of unit Gaussian
-    samples at the sample time nearest to the context's time, k period (the
-    last row after the table ends). The table is an abstract parameter (:meth:`set_noise`); by
-    default ``channel_noise(0, range(n), samples)``."""
+    samples, k the sample (k period) nearest the context's time; the last
+    row after the table ends. The table is an abstract parameter
+    (:meth:`set_noise`); by default ``channel_noise(0, range(n), samples)``."""
 
     def __init__(self, n: int, period_s: float, samples: int):
         super().__init__()
