@@ -118,25 +118,38 @@ UNDERFLOWING_ERRORS = [
 ]
 
 
-def test_a_tank_row_below_the_solvers_tolerance_is_left_out_of_the_comparison(osqp):
-    """Found on Python 3.13: a_z = -1.7e-310 and a bound of -1.7e-308 make
-    K_z <= 100, which the exact solver keeps; OSQP cannot see a row that
-    moves a'K by 1e-307 W and reaches F_ref with K_z = 128. Both are
-    feasible to 1e-6 W; the oracle comparison leaves such rows out."""
-    p = StiffnessQpProblem(
-        e=(0.0, 0.0, -0.0078125),
-        e_dot=(0.0, 0.0, 2.2250738585072014e-308),
-        damping=(24.491198419023927, 24.491198419023927, 14.139999999999999),
-        force_ref=(0.0, 0.0, -1.0),
+def _z_problem(*, e_z, e_dot_z, d_z, f_ref_z, r, a_z, lb_energy):
+    """A problem whose error, force and tank row are on z alone (x, y at rest)."""
+    return StiffnessQpProblem(
+        e=(0.0, 0.0, e_z),
+        e_dot=(0.0, 0.0, e_dot_z),
+        damping=(24.491198419023927, 24.491198419023927, d_z),
+        force_ref=(0.0, 0.0, f_ref_z),
         force_min=(-15.0, -15.0, -1.0),
         force_max=(15.0, 15.0, 15.0),
         stiffness_min=(300.0, 300.0, 100.0),
         stiffness_max=(1000.0, 1000.0, 1000.0),
         q_weight=(3200.0, 3200.0, 3200.0),
-        r_weight=(1e-05, 1e-05, 1e-05),
-        tank_a=(0.0, 0.0, -1.73833895195875e-310),
-        tank_lb_energy=-1.738338951958751e-308,
+        r_weight=(r, r, r),
+        tank_a=(0.0, 0.0, a_z),
+        tank_lb_energy=lb_energy,
         tank_lb_power=-0.1,
+    )
+
+
+def test_a_tank_row_below_the_solvers_tolerance_is_left_out_of_the_comparison(osqp):
+    """Found on Python 3.13: a_z = -1.7e-310 and a bound of -1.7e-308 make
+    K_z <= 100, which the exact solver keeps; OSQP cannot see a row that
+    moves a'K by 1e-307 W and reaches F_ref with K_z = 128. Both are
+    feasible to 1e-6 W; the oracle comparison leaves such rows out."""
+    p = _z_problem(
+        e_z=-0.0078125,
+        e_dot_z=2.2250738585072014e-308,
+        d_z=14.139999999999999,
+        f_ref_z=-1.0,
+        r=1e-05,
+        a_z=-1.73833895195875e-310,
+        lb_energy=-1.738338951958751e-308,
     )
     assert not tank_row_resolvable(p)
     exact, mp = solve_stiffness_qp_exact(p), osqp.solve(p)
@@ -151,21 +164,10 @@ def test_a_tank_row_below_the_solvers_tolerance_is_left_out_of_the_comparison(os
 def test_a_force_row_out_of_reach_of_an_underflowing_error_is_infeasible(
     osqp, e_z, e_dot_z, d_z, r, a_z
 ):
-    p = StiffnessQpProblem(
-        e=(0.0, 0.0, e_z),
-        e_dot=(0.0, 0.0, e_dot_z),
-        damping=(24.491198419023927, 24.491198419023927, d_z),
-        force_ref=(0.0, 0.0, -0.0),
-        force_min=(-15.0, -15.0, -1.0),
-        force_max=(15.0, 15.0, 15.0),
-        stiffness_min=(300.0, 300.0, 100.0),
-        stiffness_max=(1000.0, 1000.0, 1000.0),
-        q_weight=(3200.0, 3200.0, 3200.0),
-        r_weight=(r, r, r),
-        tank_a=(0.0, 0.0, a_z),
-        tank_lb_energy=-153.6,
-        tank_lb_power=-0.1,
-    )
+    p = _z_problem(
+        e_z=e_z, e_dot_z=e_dot_z, d_z=d_z, f_ref_z=-0.0, r=r, a_z=a_z,
+        lb_energy=-153.6,
+    )  # fmt: skip
     exact = solve_stiffness_qp_exact(p)
     mp = osqp.solve(p)
     assert not exact.success and not mp.success

@@ -41,16 +41,14 @@ def stage_compare_real(ctx: RunContext) -> dict:
 
     opts = ctx.options
     workers = opts.workers or max(1, min(len(names), os.cpu_count() or 1))
-    out = {}
 
     def on_done(i, result, _done) -> None:
-        out[names[i]] = result
         ctx.progress(
             f"  {names[i]}: force RMSE {result[0]['force_rmse_N']:.2f} N, "
             f"z RMSE {result[0]['z_rmse_mm']:.1f} mm"
         )
 
-    map_on_cluster(
+    results = map_on_cluster(
         _compare_real_job,
         [
             (ctx.data_dir / "experiments" / name, ctx.data_dir, opts.relaxation)
@@ -62,7 +60,7 @@ def stage_compare_real(ctx: RunContext) -> dict:
         describe=lambda i: f"the re-run of {names[i]}",
         on_done=on_done,
     )
-    out = {name: out[name] for name in names}
+    out = dict(zip(names, results, strict=True))
     ctx.tables.append(
         ReportTable(
             "Real experiments re-run in simulation (measured map)",

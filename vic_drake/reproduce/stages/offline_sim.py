@@ -22,6 +22,7 @@ def _simulate(ctx, phantom, truth, xy, *, freqs, duration, relaxation, tag) -> t
     # Function-local: the campaign and the indenter pull in pydrake (heavy).
     from vic_drake.estimation.palpation import PalpationData
     from vic_drake.experiments import CampaignParams, simulate_palpations
+    from vic_drake.experiments.rig_log import write_palpation_bag
     from vic_drake.systems.indenter import PalpationParams
 
     law = "hc" if relaxation is None else "relaxing"
@@ -65,8 +66,6 @@ def _simulate(ctx, phantom, truth, xy, *, freqs, duration, relaxation, tag) -> t
             },
         )
         if tag == "":  # The relaxing tissue's palpations also as the rig's bags.
-            from vic_drake.experiments.rig_log import write_palpation_bag
-
             bags[f] = write_palpation_bag(
                 rec,
                 ctx.out_dir / "logs" / f"palpation_sim_{f:g}hz_bag",

@@ -139,14 +139,12 @@ def stage_scans(ctx: RunContext) -> dict:
         return phantoms[key]
 
     jobs = [(scenarios[k], phantom_of(scenarios[k])) for k in runs]
-    results = {}
 
     def on_done(i, result, done) -> None:
-        results[runs[i]] = result
         _report_scan(ctx, scenarios[runs[i]], result, done, len(runs))
 
     t0 = time.perf_counter()
-    map_on_cluster(
+    simulated = map_on_cluster(
         _run_scan_job,
         jobs,
         workers,
@@ -155,6 +153,7 @@ def stage_scans(ctx: RunContext) -> dict:
         describe=lambda i: f"the scan {scenarios[runs[i]].name}",
         on_done=on_done,
     )
+    results = dict(zip(runs, simulated, strict=True))
     ctx.progress(f"  scans done in {time.perf_counter() - t0:.1f} s")
     frames: dict = {"nominal": {}, "disturbance": {}}
     metrics: dict = {"nominal": {}, "disturbance": {}}
