@@ -12,6 +12,11 @@ Per sample (:func:`prepare`):
 
 - a non-finite time, position, velocity or force, or a time that does not
   increase, is a fault: nothing changes but the fault count;
+- the contact gate (:mod:`~vic_drake.estimation.online.contact`) ends a
+  contact whose force falls back to the free-air level it rose from, even
+  above the threshold (a bias on the pressing side, read by a probe that
+  the tissue has left): until the force rises again, the samples are out
+  of contact, and the fall releases a latched surface;
 - the surface is the input's when finite; otherwise it is latched at first
   contact at the height where the current estimate gives the measured force
   (``z + (F / kappa_hat)^(1 / beta)``) and released when the force drops
@@ -40,6 +45,12 @@ from __future__ import annotations
 import math
 from typing import NamedTuple
 
+from vic_drake.estimation.online.contact import (
+    FALLEN,
+    GATE_SIZE,
+    advance_gate,
+    gate_initial_state,
+)
 from vic_drake.estimation.online.kalman import scalar_update
 from vic_drake.estimation.online.params import OnlineEstimatorParams
 
@@ -59,7 +70,8 @@ N_RESTORED = 11  # unconfirmed resets undone at the end of their contact
 F_FILT = 12  # the force through the latch's low-pass, N (NaN before the first)
 LATCH_F_MIN = 13  # lowest filtered force since the latch, N (NaN: no latch)
 LATCH_OK = 14  # 1 once the latched contact is confirmed by a rise of the force
-AUX_SIZE = 15
+GATE = 15  # the contact gate's state (contact.GATE_SIZE entries)
+AUX_SIZE = GATE + GATE_SIZE
 
 #: Fields of the estimator's outputs, in order (:class:`Estimate`).
 OUTPUT_FIELDS = (
@@ -101,6 +113,7 @@ def initial_state(x0: list[float], p0_diag: list[float]) -> list[float]:
     aux = [math.nan, math.nan, math.nan, 0.0, 0.0, 0.0, 0.0, 0.0, math.nan]
     aux += [math.nan, math.nan, 0.0]  # CLIP_START, RESET_T, N_RESTORED
     aux += [math.nan, math.nan, 0.0]  # F_FILT, LATCH_F_MIN, LATCH_OK
+    aux += gate_initial_state()
     P = [0.0] * (n * n)
     for i in range(n):
         P[i * n + i] = float(p0_diag[i])
@@ -147,7 +160,11 @@ def prepare(
         return None
     dt = 0.0 if math.isnan(aux[T_PREV]) else t - aux[T_PREV]
     aux[T_PREV] = t
-    contact = force > p.contact_threshold_N
+    # Out of contact at or below the threshold, or once the force has
+    # fallen back to the free-air level it rose from.
+    contact = advance_gate(aux, GATE, dt, z, force, p) != FALLEN and (
+        force > p.contact_threshold_N
+    )
     if math.isfinite(surface_z):
         s = surface_z
     else:

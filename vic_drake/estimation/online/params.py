@@ -75,7 +75,18 @@ class OnlineEstimatorParams:
             ``contact_threshold_N`` above its lowest value since the latch;
             until then the samples do not update the estimate (a sensor's
             bias on the pressing side reads as contact in free air); 0: the
-            latch stands at once.
+            latch stands at once (and ``contact_fall_margin_N`` is not
+            used).
+        contact_fall_margin_N: a contact whose force (low-passed as above)
+            has risen by ``contact_threshold_N`` ends when it falls back to
+            within this of the level it rose from, N, even above the
+            threshold (a probe that the tissue has left reads the sensor's
+            bias, not zero); the next contact needs the force to rise
+            again (:mod:`~vic_drake.estimation.online.contact`).
+        contact_fall_air_travel_m: ... but only once the tip has gone down
+            by at least this, m, at that level before the rise (the level
+            is then free air's, not a force of a contact the data start
+            in).
         gate_sigma: innovations are clipped at this many predicted
             standard deviations (a spike moves the estimate by a bounded
             step, a real change still gets through).
@@ -145,6 +156,8 @@ class OnlineEstimatorParams:
     contact_threshold_N: float = CONTACT_THRESHOLD_N
     min_penetration_m: float = 0.5e-3
     latch_rise_filter_s: float = 0.05
+    contact_fall_margin_N: float = 0.2
+    contact_fall_air_travel_m: float = 0.002
     gate_sigma: float = 4.0
     clip_reset_s: float = 0.05
     reset_confirm_s: float = 0.1
@@ -192,6 +205,8 @@ class OnlineEstimatorParams:
             "contact_threshold_N",
             "min_penetration_m",
             "latch_rise_filter_s",
+            "contact_fall_margin_N",
+            "contact_fall_air_travel_m",
             "surface_rate_time_constant_s",
             "clip_reset_s",
             "reset_confirm_s",

@@ -44,7 +44,9 @@ sits at its bound the tip stops moving, while the force still follows the
 depth). Its surface ``mean z + eps`` holds at the weighted mean time of
 the data; the output surface tracks it (brought to now with the tracked
 rate) through a second-order filter (see :func:`slope_step`). Everything
-restarts at each loss of contact.
+restarts at each loss of contact (the force at or below the contact
+threshold, or fallen back to the level it rose from:
+:mod:`~vic_drake.estimation.online.contact`).
 
 That is the "tracker" mode (``slope_kappa_mode``): the surface is smooth
 and kappa follows the force. Two flags from the controller's side change
@@ -85,6 +87,12 @@ from __future__ import annotations
 import math
 from typing import NamedTuple
 
+from vic_drake.estimation.online.contact import (
+    FALLEN,
+    GATE_SIZE,
+    advance_gate,
+    gate_initial_state,
+)
 from vic_drake.estimation.online.params import OnlineEstimatorParams
 from vic_drake.estimation.online.slope_gram import (
     GRAM_SIZE,
@@ -132,7 +140,8 @@ _LN_KAPPA = _KAPPA + 1  # "direct": the output ln kappa (NaN: none)
 _S_HOLD = _LN_KAPPA + 1  # the last valid solve's surface, m
 _D_SOLVE = _S_HOLD + 1  # the time covered by the last re-centring, s
 _I = _D_SOLVE + 1  # the instrument's sums (slope_instrument; zero without)
-SLOPE_SIZE = _I + INSTRUMENT_SIZE
+_GATE = _I + INSTRUMENT_SIZE  # the contact gate (kept through restarts)
+SLOPE_SIZE = _GATE + GATE_SIZE
 #: Index of the tracked surface in the state (:func:`advance`).
 SURFACE = _S_OUT
 
@@ -168,6 +177,7 @@ def slope_initial_state() -> list[float]:
         _KAPPA, _LN_KAPPA, _S_HOLD,
     ):  # fmt: skip
         state[i] = math.nan
+    state[_GATE:] = gate_initial_state()
     return state
 
 
@@ -200,7 +210,7 @@ def _recentre(s: list[float], t: float, p: OnlineEstimatorParams, instrumented: 
     scale = math.exp(-d / p.slope_memory_s)
     s[_G : _FF + 1] = shift_basis(s[_G : _FF + 1], d, dz, scale)
     if instrumented:
-        s[_I:] = shift_instruments(s[_I:], d, dz, scale)
+        s[_I:_GATE] = shift_instruments(s[_I:_GATE], d, dz, scale)
     s[_D_SOLVE] = d
     s[_T_REF] = t
     s[_Z_REF] += dz
@@ -224,7 +234,7 @@ def _solve(
     s[_Z_MEAN] = s[_Z_REF] - sums[_Z] / w0
     s[_T_MEAN] = s[_T_REF] + sums[1] / w0
     s[_VALID] = 0.0
-    fit = solve_instrumented(sums, s[_I:]) if instrumented else solve_sums(sums)
+    fit = solve_instrumented(sums, s[_I:_GATE]) if instrumented else solve_sums(sums)
     if fit is None:  # G not positive definite: no solve, as a singular one.
         return
     schur_z, slope, residual, var_factor = fit
@@ -308,7 +318,9 @@ def slope_step(
         t: time, s (a sample not after the last good one is ignored).
         z, z_dot: tip height, m, and its rate, m/s.
         force: tissue force on the probe, N (positive = pushing it up);
-            at or below ``params.contact_threshold_N`` everything restarts.
+            at or below ``params.contact_threshold_N``, or fallen back to
+            the level it rose from (:mod:`~vic_drake.estimation.online.contact`),
+            everything restarts.
         params: ``slope_memory_s``, ``slope_min_motion_m``,
             ``slope_surface_time_s``, ``beta``, ``contact_threshold_N``.
         surface_start: see above, m ("tracker" mode).
@@ -354,8 +366,13 @@ def advance(
     ):
         return
     dt = 0.0 if math.isnan(s[_T_LAST]) else t - s[_T_LAST]
-    if force <= p.contact_threshold_N:
+    if (
+        advance_gate(s, _GATE, dt, z, force, p) == FALLEN
+        or force <= p.contact_threshold_N
+    ):
+        gate = s[_GATE:]
         s[:] = slope_initial_state()
+        s[_GATE:] = gate
         s[_T_LAST] = t
         return
     s[_T_LAST] = t
@@ -371,8 +388,8 @@ def advance(
         s[_G : _FF + 1] = add_sample(s[_G : _FF + 1], w, tau, e, -z_dot, force)
         if instrumented:
             phase = 2.0 * math.pi * dither_hz * t
-            s[_I:] = add_instrument_sample(
-                s[_I:], w, tau, e, -z_dot, force, math.sin(phase), math.cos(phase)
+            s[_I:_GATE] = add_instrument_sample(
+                s[_I:_GATE], w, tau, e, -z_dot, force, math.sin(phase), math.cos(phase)
             )
     s[_COUNT] += 1.0
     if s[_COUNT] >= SOLVE_EVERY:

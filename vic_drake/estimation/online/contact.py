@@ -1,0 +1,142 @@
+"""When a contact ends above the contact threshold: the force's fall back
+to the free-air level it rose from.
+
+The sensor's force is the tissue's plus whatever the sensor adds. A bias on
+the pressing side stands above the contact threshold in free air, so a
+probe that the tissue leaves (a breathing chest that draws away) reads the
+bias, and the threshold never ends the contact. The gate follows the force
+through a first-order low-pass (``latch_rise_filter_s``, each sample's
+step clipped at :data:`MAX_STEP_N`) and keeps:
+
+- the filtered force;
+- the level the contact rose from: the filtered force's lowest value since
+  the gate was armed (the raw force above ``contact_threshold_N``, or the
+  filtered one still above it: a single low sample inside a contact, from
+  noise or a spike, does not disarm it);
+- the phase: :data:`ONSET` (armed, the force has not yet risen by
+  ``contact_threshold_N`` above that level), :data:`RISEN` (it has), or
+  :data:`FALLEN` (it had risen and has fallen back to within
+  ``contact_fall_margin_N`` of that level; from the fall on, the level is
+  tracked anew and the force must rise again);
+- the free-air descent: how far below its highest point since the gate
+  was armed the tip has been while the filtered force was within
+  ``contact_fall_margin_N`` of that level (and that highest point). A
+  net descent: the back and forth of a dither or a palpation does not add
+  up.
+
+The fall counts only once the free-air descent is at least
+``contact_fall_air_travel_m``: the tip went down with nothing answering,
+so the level is what the sensor reads in free air. A gate armed inside a
+contact (a log that starts pressed in) has a level that is tissue force:
+a palpation that returns to the depth it started from has not left the
+tissue, and only the threshold ends its contacts. With an unbiased
+sensor the level is at most about the threshold, and the fall ends a
+contact about where the threshold does.
+
+``latch_rise_filter_s`` 0: the gate is never :data:`FALLEN`.
+
+The callers (:func:`~vic_drake.estimation.online.core.prepare` and the
+slope fit's :func:`~vic_drake.estimation.online.slope.advance`) keep the
+gate's state in their own at an offset; :data:`FALLEN` is out of contact
+for both (docs/decisions.md, "A contact ends where its force falls
+back").
+"""
+
+from __future__ import annotations
+
+import math
+
+from vic_drake.estimation.online.params import OnlineEstimatorParams
+
+#: Entries of the gate's state: the filtered force, N (NaN before the
+#: first sample); the level the contact rose from, N (NaN: not armed);
+#: the phase; the free-air descent, m; the tip's highest point since
+#: armed, m (NaN: not armed).
+GATE_SIZE = 5
+#: The filter takes at most this step of the force from one sample, N: a
+#: spike (tens of N for a sample) would otherwise move the level that a
+#: contact rises from, and its decay would read as a rise.
+MAX_STEP_N = 2.0
+#: Phases. OUT: the force and the filtered force are at or below the
+#: threshold (not armed).
+OUT, ONSET, RISEN, FALLEN = 0.0, 1.0, 2.0, 3.0
+
+
+def gate_initial_state() -> list[float]:
+    """A gate before its first sample."""
+    return [math.nan, math.nan, OUT, 0.0, math.nan]
+
+
+def advance_gate(
+    g: list[float],
+    i: int,
+    dt: float,
+    z: float,
+    force: float,
+    p: OnlineEstimatorParams,
+) -> float:
+    """One good sample of the gate at ``g[i:i + GATE_SIZE]`` (in place).
+
+    Args:
+        g, i: the state list and the gate's offset in it.
+        dt: time since the previous good sample, s (0 at the first; a gap
+            longer than ``p.max_gap_s`` restarts the filter).
+        z: the tip's height, m (down = into the tissue).
+        force: the sample's force, N (positive: pushing the probe up).
+        p: ``latch_rise_filter_s``, ``contact_threshold_N``,
+            ``contact_fall_margin_N``, ``contact_fall_air_travel_m``,
+            ``max_gap_s``.
+
+    Returns:
+        The phase after the sample.
+    """
+    tau = p.latch_rise_filter_s
+    threshold = p.contact_threshold_N
+    f = g[i]
+    if tau == 0.0 or math.isnan(f) or not 0.0 < dt <= p.max_gap_s:
+        f = force
+    else:  # A spike moves the filter as a step of MAX_STEP_N would.
+        f += dt / (tau + dt) * min(max(force - f, -MAX_STEP_N), MAX_STEP_N)
+    g[i] = f
+    if not (force > threshold or f > threshold):
+        g[i + 1] = math.nan
+        g[i + 2] = OUT
+        g[i + 3] = 0.0
+        g[i + 4] = math.nan
+        return OUT
+    if not z <= g[i + 4]:  # The highest tip since the gate was armed.
+        g[i + 4] = z
+    phase = g[i + 2]
+    margin = p.contact_fall_margin_N
+    if phase == RISEN:
+        if (
+            tau > 0.0
+            and f <= g[i + 1] + margin
+            and g[i + 3] >= p.contact_fall_air_travel_m
+        ):
+            g[i + 1] = f
+            g[i + 2] = FALLEN
+            return FALLEN
+        return RISEN
+    if not f >= g[i + 1]:  # A new low (NaN: the first armed sample).
+        g[i + 1] = f
+    if f <= g[i + 1] + margin:  # At the level: free air, so far.
+        g[i + 3] = max(g[i + 3], g[i + 4] - z)
+    if phase == OUT:
+        phase = ONSET
+    if tau == 0.0 or f - g[i + 1] >= threshold:
+        phase = RISEN
+    g[i + 2] = phase
+    return phase
+
+
+__all__ = [
+    "FALLEN",
+    "GATE_SIZE",
+    "MAX_STEP_N",
+    "ONSET",
+    "OUT",
+    "RISEN",
+    "advance_gate",
+    "gate_initial_state",
+]
