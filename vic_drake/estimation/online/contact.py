@@ -60,6 +60,7 @@ MAX_STEP_N = 2.0
 #: Phases. OUT: the force and the filtered force are at or below the
 #: threshold (not armed).
 OUT, ONSET, RISEN, FALLEN = 0.0, 1.0, 2.0, 3.0
+_DISARMED = [math.nan, OUT, 0.0, math.nan]  # the gate's state but the force
 
 
 def gate_initial_state() -> list[float]:
@@ -93,39 +94,36 @@ def advance_gate(
     tau = p.latch_rise_filter_s
     threshold = p.contact_threshold_N
     f = g[i]
-    if tau == 0.0 or math.isnan(f) or not 0.0 < dt <= p.max_gap_s:
+    if tau == 0.0 or f != f or not 0.0 < dt <= p.max_gap_s:  # (f != f: NaN)
         f = force
     else:  # A spike moves the filter as a step of MAX_STEP_N would.
-        f += dt / (tau + dt) * min(max(force - f, -MAX_STEP_N), MAX_STEP_N)
+        step = force - f
+        step = -MAX_STEP_N if step < -MAX_STEP_N else min(step, MAX_STEP_N)
+        f += dt / (tau + dt) * step
     g[i] = f
-    if not (force > threshold or f > threshold):
-        g[i + 1] = math.nan
-        g[i + 2] = OUT
-        g[i + 3] = 0.0
-        g[i + 4] = math.nan
+    if force <= threshold and f <= threshold:
+        g[i + 1 : i + GATE_SIZE] = _DISARMED
         return OUT
     if not z <= g[i + 4]:  # The highest tip since the gate was armed.
         g[i + 4] = z
     phase = g[i + 2]
-    margin = p.contact_fall_margin_N
     if phase == RISEN:
-        if (
-            tau > 0.0
-            and f <= g[i + 1] + margin
-            and g[i + 3] >= p.contact_fall_air_travel_m
-        ):
-            g[i + 1] = f
-            g[i + 2] = FALLEN
-            return FALLEN
-        return RISEN
-    if not f >= g[i + 1]:  # A new low (NaN: the first armed sample).
+        if f > g[i + 1] + p.contact_fall_margin_N or tau == 0.0:
+            return RISEN
+        if g[i + 3] < p.contact_fall_air_travel_m:
+            return RISEN
         g[i + 1] = f
-    if f <= g[i + 1] + margin:  # At the level: free air, so far.
+        g[i + 2] = FALLEN
+        return FALLEN
+    level = g[i + 1]
+    if not f >= level:  # A new low (NaN: the first armed sample).
+        g[i + 1] = level = f
+    if f <= level + p.contact_fall_margin_N:  # At the level: free air, so far.
         g[i + 3] = max(g[i + 3], g[i + 4] - z)
-    if phase == OUT:
-        phase = ONSET
-    if tau == 0.0 or f - g[i + 1] >= threshold:
+    if tau == 0.0 or f - level >= threshold:
         phase = RISEN
+    elif phase == OUT:
+        phase = ONSET
     g[i + 2] = phase
     return phase
 
