@@ -16,7 +16,7 @@ Per sample (:func:`prepare`):
   contact whose force falls back to the free-air level it rose from, even
   above the threshold (a bias on the pressing side, read by a probe that
   the tissue has left): until the force rises again, the samples are out
-  of contact, and the fall releases a latched surface;
+  of contact, and a latched surface is released;
 - the surface is the input's when finite; otherwise it is latched at first
   contact at the height where the current estimate gives the measured force
   (``z + (F / kappa_hat)^(1 / beta)``) and released when the force drops
@@ -25,8 +25,9 @@ Per sample (:func:`prepare`):
   where the surface is latched; until then the sample is out of contact;
 - the surface rate s_dot is a first-order low-pass of its finite
   differences, restarted after a gap longer than ``max_gap_s``;
-- contact: force above ``contact_threshold_N`` and penetration above
-  ``min_penetration_m``; only samples in contact update x;
+- contact: force above ``contact_threshold_N``, not fallen back (the
+  gate), and penetration above ``min_penetration_m``; only samples in
+  contact update x;
 - innovations are clipped at ``gate_sigma`` (spikes); when every update
   has been clipped for ``clip_reset_s``, P returns to the prior
   (:func:`record_clip`; updates whose estimate predicts a pulling force
@@ -150,7 +151,8 @@ def prepare(
     Returns:
         None on a fault, else (the surface height, m, NaN if unknown; the
         surface rate, m/s; whether the force is above the contact
-        threshold: the penetration test is the filter's). A plain tuple:
+        threshold and the contact gate has not seen it fall back: the
+        penetration test is the filter's). A plain tuple:
         a NamedTuple would cost a tenth of the RLS's tick.
     """
     if not math.isfinite(t + z + z_dot + force) or not (
