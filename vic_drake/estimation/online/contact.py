@@ -65,7 +65,7 @@ _DISARMED = [math.nan, OUT, 0.0, math.nan]  # the gate's state but the force
 
 def gate_initial_state() -> list[float]:
     """A gate before its first sample."""
-    return [math.nan, math.nan, OUT, 0.0, math.nan]
+    return [math.nan, *_DISARMED]
 
 
 def advance_gate(

@@ -145,8 +145,14 @@ def prepare(
     kappa_hat: float,
     beta: float,
     p: OnlineEstimatorParams,
+    gate_phase: float | None = None,
 ) -> tuple[float, float, bool] | None:
     """Bookkeeping of one sample (updates ``aux`` in place).
+
+    ``gate_phase``: the contact gate's phase for this sample from a gate
+    that the caller ran on the same samples (the slope fit's, in
+    :func:`~vic_drake.estimation.online.ekf.ekf_slope_step`); None: the
+    gate in ``aux`` runs.
 
     Returns:
         None on a fault, else (the surface height, m, NaN if unknown; the
@@ -164,9 +170,9 @@ def prepare(
     aux[T_PREV] = t
     # Out of contact at or below the threshold, or once the force has
     # fallen back to the free-air level it rose from.
-    contact = advance_gate(aux, GATE, dt, z, force, p) != FALLEN and (
-        force > p.contact_threshold_N
-    )
+    if gate_phase is None:
+        gate_phase = advance_gate(aux, GATE, dt, z, force, p)
+    contact = gate_phase != FALLEN and force > p.contact_threshold_N
     if math.isfinite(surface_z):
         s = surface_z
     else:

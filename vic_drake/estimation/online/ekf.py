@@ -103,16 +103,19 @@ def ekf_step(
     force: float,
     surface_z: float,
     params: OnlineEstimatorParams,
+    gate_phase: float | None = None,
 ) -> tuple[list[float], Estimate]:
     """One sample; arguments and result as :func:`~vic_drake.estimation.online.rls.rls_step`.
 
     ``surface_z_m`` of the estimate is the corrected surface s_in + ds.
+    ``gate_phase``: as :func:`~vic_drake.estimation.online.core.prepare`'s.
     """
     p = params
     n, i_s, i_b = ekf_layout(p)
     aux, x, P, saved = unpack(state, n)
     beta = x[i_b] if i_b is not None else p.beta
-    sample = prepare(aux, t, z, z_dot, force, surface_z, x[0] * p.kappa_prior, beta, p)
+    kappa_hat = x[0] * p.kappa_prior
+    sample = prepare(aux, t, z, z_dot, force, surface_z, kappa_hat, beta, p, gate_phase)
     ds = x[i_s] * _MM if i_s is not None else 0.0
     if sample is None:
         aux[IN_CONTACT] = 0.0
@@ -173,19 +176,23 @@ def ekf_slope_step(
     (arguments and result as :func:`ekf_step`; ``saturated`` and
     ``at_force_bound``: the controller's stiffness and force at their
     bounds, and ``dither_hz`` its dither's frequency, for the fit,
-    :func:`~vic_drake.estimation.online.slope.slope_step`)."""
+    :func:`~vic_drake.estimation.online.slope.slope_step`).
+
+    The fit and the EKF see the same samples, so the fit's contact gate
+    serves both (the gate entries of the EKF's part of the state stay
+    unused)."""
     p = params
     if type(state) is not list:  # (slices of an array would be views)
         state = list(state)
     size = state_size(ekf_layout(p)[0])
     fit = state[size:]
-    advance(
+    phase = advance(
         fit, t, z, z_dot, force, p, state[S_PREV], saturated, at_force_bound,
         dither_hz,
     )  # fmt: skip
     if math.isnan(surface_z):
         surface_z = fit[SURFACE]
-    ekf_state, est = ekf_step(state[:size], t, z, z_dot, force, surface_z, p)
+    ekf_state, est = ekf_step(state[:size], t, z, z_dot, force, surface_z, p, phase)
     return ekf_state + fit, est
 
 

@@ -357,24 +357,28 @@ def advance(
     saturated: bool = False,
     at_force_bound: bool = False,
     dither_hz: float = 0.0,
-) -> None:
+) -> float | None:
     """:func:`slope_step` on the state ``s`` in place, without the estimate
-    (its surface is ``s[SURFACE]``)."""
+    (its surface is ``s[SURFACE]``).
+
+    Returns:
+        The contact gate's phase after the sample
+        (:mod:`~vic_drake.estimation.online.contact`), None for a sample
+        that is not finite or not after the last good one (ignored).
+    """
     p = params
     if not math.isfinite(t + z + z_dot + force) or not (
         math.isnan(s[_T_LAST]) or t > s[_T_LAST]
     ):
-        return
+        return None
     dt = 0.0 if math.isnan(s[_T_LAST]) else t - s[_T_LAST]
-    if (
-        advance_gate(s, _GATE, dt, z, force, p) == FALLEN
-        or force <= p.contact_threshold_N
-    ):
+    phase = advance_gate(s, _GATE, dt, z, force, p)
+    if phase == FALLEN or force <= p.contact_threshold_N:
         gate = s[_GATE:]
         s[:] = slope_initial_state()
         s[_GATE:] = gate
         s[_T_LAST] = t
-        return
+        return phase
     s[_T_LAST] = t
     if math.isnan(s[_T_REF]):
         s[_T_REF] = s[_T_START] = t
@@ -411,6 +415,7 @@ def advance(
             )
             s[_S_OUT] += dt * (v + 2.0 * wn * e)
             s[_V_OUT] += dt * wn * wn * e
+    return phase
 
 
 def _estimate(s: list[float]) -> SlopeEstimate:
