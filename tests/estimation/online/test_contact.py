@@ -1,6 +1,7 @@
 """The contact gate: a contact ends where its force falls back to the
 free-air level it rose from, even above the contact threshold (a sensor
-biased on the pressing side, a tissue that draws away from the probe)."""
+biased on the pressing side, a tissue that draws away from the probe);
+that level, confirmed in free air, tares the force."""
 
 import math
 
@@ -13,6 +14,7 @@ from vic_drake.estimation.online.contact import (
     FALLEN,
     ONSET,
     RISEN,
+    TARE,
     advance_gate,
     gate_initial_state,
 )
@@ -43,15 +45,17 @@ def _chest_draws_away(bias_N, *, seed=0, noise_N=0.05):
     return t, z, z_dot, force, s, tissue
 
 
-def _gate_phases(t, z, force, params):
+def _gate_phases(t, z, force, params, *, tares=False):
+    """The gate's phase after each sample (and its tare, ``tares``)."""
     g = gate_initial_state()
-    phases = np.empty(t.size)
+    phases, tare = np.empty(t.size), np.empty(t.size)
     previous = math.nan
     for k in range(t.size):
         dt = 0.0 if math.isnan(previous) else t[k] - previous
         previous = t[k]
         phases[k] = advance_gate(g, 0, dt, z[k], force[k], params)
-    return phases
+        tare[k] = g[TARE]
+    return (phases, tare) if tares else phases
 
 
 @pytest.mark.parametrize("bias_N", [0.8, 1.6, 2.5])
@@ -156,3 +160,78 @@ def test_without_the_filter_the_gate_never_falls():
     t, z, _, force, _, _ = _chest_draws_away(1.6)
     phases = _gate_phases(t, z, force, params)
     assert not np.any(phases == FALLEN)
+
+
+@pytest.mark.parametrize("bias_N", [0.8, 1.6, 2.5])
+def test_the_tare_is_the_bias_once_the_tip_has_descended_in_free_air(bias_N):
+    """The tip comes down 5 mm in free air before it touches (at 0.33 s):
+    0 until it has gone down 2 mm (0.13 s), then the bias to within the
+    filtered noise, through the contact and after the tissue comes back.
+    At the fall (the tissue leaves), the tare is the filtered force, still
+    coming down to the level: it follows it within 0.1 s."""
+    t, z, _, force, _, _ = _chest_draws_away(bias_N)
+    phases, tare = _gate_phases(t, z, force, OnlineEstimatorParams(), tares=True)
+    assert np.all(tare[t < 0.13] == 0.0)
+    fell = t[np.flatnonzero(phases == FALLEN)[0]]
+    settled = (t > 0.14) & ((t < fell) | (t > fell + 0.1))
+    assert np.all(np.abs(tare[settled] - bias_N) < 0.05)
+    assert np.all(np.abs(tare[t > fell] - bias_N) < 0.25)
+
+
+@pytest.mark.parametrize("bias_N", [-1.0, 0.0, 0.4])
+def test_no_tare_at_or_below_the_threshold(bias_N):
+    t, z, _, force, _, _ = _chest_draws_away(bias_N)
+    _, tare = _gate_phases(t, z, force, OnlineEstimatorParams(), tares=True)
+    assert np.all(tare == 0.0)
+
+
+def test_no_tare_on_a_tissue_soft_enough_to_be_flat_at_the_threshold():
+    """kappa 300: the force stays within the fall margin over more than the
+    free-air travel after it crosses the threshold, but the level is the
+    threshold's, not a reading above it."""
+    t = np.arange(0.0, 2.0, DT)
+    z = 0.105 - 0.015 * t
+    force = 300.0 * np.maximum(0.1 - z, 0.0) ** BETA
+    params = OnlineEstimatorParams()
+    flat = (force > 0.5) & (force < 0.7)
+    assert np.ptp(z[flat]) > params.contact_fall_air_travel_m
+    _, tare = _gate_phases(t, z, force, params, tares=True)
+    assert np.all(tare == 0.0)
+
+
+def test_the_tare_ends_when_the_reading_drops_to_the_threshold():
+    """A bias of 1.6 N that goes away in free air (at 0.3 s)."""
+    t = np.arange(0.0, 0.6, DT)
+    z = 0.11 - 0.015 * t
+    force = np.where(t < 0.3, 1.6, 0.0)
+    _, tare = _gate_phases(t, z, force, OnlineEstimatorParams(), tares=True)
+    assert tare[np.flatnonzero(t < 0.3)[-1]] == pytest.approx(1.6)
+    assert np.all(tare[t > 0.4] == 0.0)
+
+
+@pytest.mark.parametrize(
+    "method, from_slope", [("rls", False), ("ekf", False), ("ekf", True)]
+)
+def test_a_biased_probe_estimates_as_an_unbiased_one(method, from_slope):
+    """Before the tissue leaves (1.4 s), the tared estimate and its surface
+    are those of the same data without the bias; untared (the free-air
+    travel never reached), the bias moves the surface by a millimetre or
+    more and kappa by percents."""
+    params = OnlineEstimatorParams(
+        method=method, kappa_prior=3000.0, surface_from_slope=from_slope
+    )
+    k = int(round(1.4 / DT))
+
+    def at_1_4_s(bias_N, params):
+        t, z, v, force, _, _ = _chest_draws_away(bias_N)
+        trace = run_online(t, z, v, force, math.nan, params)
+        return trace.kappa[k], trace.column("surface_z_m")[k]
+
+    kappa0, surface0 = at_1_4_s(0.0, params)
+    kappa, surface = at_1_4_s(1.6, params)
+    assert kappa == pytest.approx(kappa0, rel=0.01)
+    assert surface == pytest.approx(surface0, abs=5e-5)
+    params.contact_fall_air_travel_m = 1.0
+    kappa, surface = at_1_4_s(1.6, params)
+    assert abs(kappa / kappa0 - 1.0) > 0.02
+    assert abs(surface - surface0) > 1e-3

@@ -33,7 +33,27 @@ tissue, and only the threshold ends its contacts. With an unbiased
 sensor the level is at most about the threshold, and the fall ends a
 contact about where the threshold does.
 
-``latch_rise_filter_s`` 0: the gate is never :data:`FALLEN`.
+The gate also keeps the sensor's **tare**: the level, when the free-air
+descent has confirmed it as the sensor's free-air reading (at the level,
+in :data:`ONSET` or :data:`FALLEN`) and it is above the contact threshold
+(a free-air reading that would read as contact: a bias on the pressing
+side). The gate's disarming (a reading at or below the threshold) sets
+the tare back to 0: the sensor then reads at most the threshold, as an
+unbiased one does. So an unbiased sensor, a bias at or below the
+threshold, and a log that starts pressed in are not tared; a tissue so
+soft that its force stays within ``contact_fall_margin_N`` over
+``contact_fall_air_travel_m`` arms the gate at about the threshold,
+which a level above the threshold leaves out. The callers subtract the
+tare from the force before anything else reads it: the contact test, the
+surface latch, the update and the slope fit then see the tissue's force,
+not the bias (a bias read as tissue force starts kappa high, and a latch
+at the lowest value of a flat biased reading stands millimetres above the
+tissue). Taring at the level (the filtered force's lowest value) leaves
+that value's noise excursion below the bias's mean in the tared force: a
+small part of the filter's noise, well below the threshold.
+
+``latch_rise_filter_s`` 0: the gate is never :data:`FALLEN` and never
+tares.
 
 The callers (:func:`~vic_drake.estimation.online.core.prepare` and the
 slope fit's :func:`~vic_drake.estimation.online.slope.advance`) keep the
@@ -51,8 +71,10 @@ from vic_drake.estimation.online.params import OnlineEstimatorParams
 #: Entries of the gate's state: the filtered force, N (NaN before the
 #: first sample); the level the contact rose from, N (NaN: not armed);
 #: the phase; the free-air descent, m; the tip's highest point since
-#: armed, m (NaN: not armed).
-GATE_SIZE = 5
+#: armed, m (NaN: not armed); the tare, N (at :data:`TARE`).
+GATE_SIZE = 6
+#: Offset of the tare in the gate's state, N (0 until a free-air level).
+TARE = 5
 #: The filter takes at most this step of the force from one sample, N: a
 #: spike (tens of N for a sample) would otherwise move the level that a
 #: contact rises from, and its decay would read as a rise.
@@ -60,7 +82,7 @@ MAX_STEP_N = 2.0
 #: Phases. OUT: the force and the filtered force are at or below the
 #: threshold (not armed).
 OUT, ONSET, RISEN, FALLEN = 0.0, 1.0, 2.0, 3.0
-_DISARMED = [math.nan, OUT, 0.0, math.nan]  # the gate's state but the force
+_DISARMED = [math.nan, OUT, 0.0, math.nan, 0.0]  # the gate's state but the force
 
 
 def gate_initial_state() -> list[float]:
@@ -89,7 +111,7 @@ def advance_gate(
             ``max_gap_s``.
 
     Returns:
-        The phase after the sample.
+        The phase after the sample (the tare after it: ``g[i + TARE]``).
     """
     tau = p.latch_rise_filter_s
     threshold = p.contact_threshold_N
@@ -113,6 +135,7 @@ def advance_gate(
         if g[i + 3] < p.contact_fall_air_travel_m:
             return RISEN
         g[i + 1] = f
+        g[i + TARE] = f if f > threshold else 0.0
         g[i + 2] = FALLEN
         return FALLEN
     level = g[i + 1]
@@ -120,6 +143,9 @@ def advance_gate(
         g[i + 1] = level = f
     if f <= level + p.contact_fall_margin_N:  # At the level: free air, so far.
         g[i + 3] = max(g[i + 3], g[i + 4] - z)
+        if tau != 0.0 and g[i + 3] >= p.contact_fall_air_travel_m:
+            # Free air confirmed: the level is the sensor's reading.
+            g[i + TARE] = level if level > threshold else 0.0
     if tau == 0.0 or f - level >= threshold:
         phase = RISEN
     elif phase == OUT:
@@ -135,6 +161,7 @@ __all__ = [
     "ONSET",
     "OUT",
     "RISEN",
+    "TARE",
     "advance_gate",
     "gate_initial_state",
 ]

@@ -16,7 +16,9 @@ Per sample (:func:`prepare`):
   contact whose force falls back to the free-air level it rose from, even
   above the threshold (a bias on the pressing side, read by a probe that
   the tissue has left): until the force rises again, the samples are out
-  of contact, and a latched surface is released;
+  of contact, and a latched surface is released. Its tare (that free-air
+  level once confirmed, 0 until then) is subtracted from the force before
+  the rest reads it;
 - the surface is the input's when finite; otherwise it is latched at first
   contact at the height where the current estimate gives the measured force
   (``z + (F / kappa_hat)^(1 / beta)``) and released when the force drops
@@ -49,6 +51,7 @@ from typing import NamedTuple
 from vic_drake.estimation.online.contact import (
     FALLEN,
     GATE_SIZE,
+    TARE,
     advance_gate,
     gate_initial_state,
 )
@@ -146,20 +149,21 @@ def prepare(
     beta: float,
     p: OnlineEstimatorParams,
     gate_phase: float | None = None,
-) -> tuple[float, float, bool] | None:
+) -> tuple[float, float, bool, float] | None:
     """Bookkeeping of one sample (updates ``aux`` in place).
 
     ``gate_phase``: the contact gate's phase for this sample from a gate
     that the caller ran on the same samples (the slope fit's, in
-    :func:`~vic_drake.estimation.online.ekf.ekf_slope_step`); None: the
-    gate in ``aux`` runs.
+    :func:`~vic_drake.estimation.online.ekf.ekf_slope_step`), with
+    ``force`` tared by that gate; None: the gate in ``aux`` runs and tares
+    the force.
 
     Returns:
         None on a fault, else (the surface height, m, NaN if unknown; the
-        surface rate, m/s; whether the force is above the contact
+        surface rate, m/s; whether the tared force is above the contact
         threshold and the contact gate has not seen it fall back: the
-        penetration test is the filter's). A plain tuple:
-        a NamedTuple would cost a tenth of the RLS's tick.
+        penetration test is the filter's; the tared force, N). A plain
+        tuple: a NamedTuple would cost a tenth of the RLS's tick.
     """
     if not math.isfinite(t + z + z_dot + force) or not (
         math.isnan(aux[T_PREV]) or t > aux[T_PREV]
@@ -172,6 +176,7 @@ def prepare(
     # fallen back to the free-air level it rose from.
     if gate_phase is None:
         gate_phase = advance_gate(aux, GATE, dt, z, force, p)
+        force -= aux[GATE + TARE]
     contact = gate_phase != FALLEN and force > p.contact_threshold_N
     if math.isfinite(surface_z):
         s = surface_z
@@ -185,7 +190,7 @@ def prepare(
     else:
         aux[S_DOT] = 0.0
     aux[S_PREV] = s
-    return s, aux[S_DOT], contact
+    return s, aux[S_DOT], contact, force
 
 
 def _latch(

@@ -48,7 +48,12 @@ from vic_drake.estimation.online.core import (
     unpack,
 )
 from vic_drake.estimation.online.params import OnlineEstimatorParams
-from vic_drake.estimation.online.slope import SURFACE, advance, slope_initial_state
+from vic_drake.estimation.online.slope import (
+    SURFACE,
+    TARE,
+    advance,
+    slope_initial_state,
+)
 
 _MM = 1e-3
 
@@ -121,7 +126,7 @@ def ekf_step(
         aux[IN_CONTACT] = 0.0
         est = make_estimate(aux, x, P, p, aux[S_PREV] + ds, False)
         return aux + x + P + saved, est
-    s_in, s_dot, touching = sample
+    s_in, s_dot, touching, force = sample  # the force tared
     surface = s_in + ds
     eps = surface - z
     contact = touching and eps > p.min_penetration_m
@@ -179,8 +184,8 @@ def ekf_slope_step(
     :func:`~vic_drake.estimation.online.slope.slope_step`).
 
     The fit and the EKF see the same samples, so the fit's contact gate
-    serves both (the gate entries of the EKF's part of the state stay
-    unused)."""
+    serves both, its tare included (the gate entries of the EKF's part of
+    the state stay unused)."""
     p = params
     if type(state) is not list:  # (slices of an array would be views)
         state = list(state)
@@ -192,6 +197,7 @@ def ekf_slope_step(
     )  # fmt: skip
     if math.isnan(surface_z):
         surface_z = fit[SURFACE]
+    force -= fit[TARE]
     ekf_state, est = ekf_step(state[:size], t, z, z_dot, force, surface_z, p, phase)
     return ekf_state + fit, est
 

@@ -86,7 +86,7 @@ def rls_step(
     if sample is None:
         aux[IN_CONTACT] = 0.0
         return aux + x + P + saved, make_estimate(aux, x, P, p, aux[S_PREV], False)
-    s_in, s_dot, touching = sample
+    s_in, s_dot, touching, force = sample  # the force tared
     eps = s_in - z
     contact = touching and eps > p.min_penetration_m
     if contact:

@@ -93,6 +93,7 @@ from vic_drake.estimation.online.contact import (
     advance_gate,
     gate_initial_state,
 )
+from vic_drake.estimation.online.contact import TARE as _GATE_TARE
 from vic_drake.estimation.online.params import OnlineEstimatorParams
 from vic_drake.estimation.online.slope_gram import (
     GRAM_SIZE,
@@ -144,6 +145,9 @@ _GATE = _I + INSTRUMENT_SIZE  # the contact gate (kept through restarts)
 SLOPE_SIZE = _GATE + GATE_SIZE
 #: Index of the tracked surface in the state (:func:`advance`).
 SURFACE = _S_OUT
+#: Index of the contact gate's tare in the state, N (:func:`advance`
+#: subtracts it from the force).
+TARE = _GATE + _GATE_TARE
 
 
 class SlopeEstimate(NamedTuple):
@@ -318,9 +322,10 @@ def slope_step(
         t: time, s (a sample not after the last good one is ignored).
         z, z_dot: tip height, m, and its rate, m/s.
         force: tissue force on the probe, N (positive = pushing it up);
-            at or below ``params.contact_threshold_N``, or fallen back to
-            the level it rose from (:mod:`~vic_drake.estimation.online.contact`),
-            everything restarts.
+            the contact gate's tare
+            (:mod:`~vic_drake.estimation.online.contact`) is subtracted
+            from it. At or below ``params.contact_threshold_N``, or fallen
+            back to the level it rose from, everything restarts.
         params: ``slope_memory_s``, ``slope_min_motion_m``,
             ``slope_surface_time_s``, ``beta``, ``contact_threshold_N``.
         surface_start: see above, m ("tracker" mode).
@@ -373,6 +378,7 @@ def advance(
         return None
     dt = 0.0 if math.isnan(s[_T_LAST]) else t - s[_T_LAST]
     phase = advance_gate(s, _GATE, dt, z, force, p)
+    force -= s[TARE]
     if phase == FALLEN or force <= p.contact_threshold_N:
         gate = s[_GATE:]
         s[:] = slope_initial_state()
@@ -431,6 +437,7 @@ __all__ = [
     "SOLVE_EVERY",
     "SURFACE",
     "SlopeEstimate",
+    "TARE",
     "advance",
     "slope_initial_state",
     "slope_step",
