@@ -86,7 +86,9 @@ class OnlineEstimatorParams:
         contact_fall_air_travel_m: ... but only once the tip has gone down
             by at least this, m, at that level before the rise (the level
             is then free air's, not a force of a contact the data start
-            in).
+            in). Such a level above ``contact_threshold_N`` is also the
+            sensor's tare: it is subtracted from the force until the
+            reading drops to the threshold.
         gate_sigma: innovations are clipped at this many predicted
             standard deviations (a spike moves the estimate by a bounded
             step, a real change still gets through).
