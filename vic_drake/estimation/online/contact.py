@@ -59,7 +59,7 @@ The callers (:func:`~vic_drake.estimation.online.core.prepare` and the
 slope fit's :func:`~vic_drake.estimation.online.slope.advance`) keep the
 gate's state in their own at an offset; :data:`FALLEN` is out of contact
 for both (docs/decisions.md, "A contact ends where its force falls
-back").
+back" and "The online tare").
 """
 
 from __future__ import annotations
