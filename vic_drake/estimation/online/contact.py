@@ -24,6 +24,15 @@ step clipped at :data:`MAX_STEP_N`) and keeps:
   net descent: the back and forth of a dither or a palpation does not add
   up.
 
+The filter starts from a raw sample (the first, or the first after a gap
+longer than ``max_gap_s``), which holds the raw noise and can be a spike.
+Until it has settled (:data:`SETTLE_TIME_CONSTANTS` filter time
+constants), an armed gate takes no level, counts no descent and sees no
+rise or fall: a first sample a few tenths of a newton low would otherwise
+stand as a level that the filtered force never comes back to within
+``contact_fall_margin_N``, and neither the free-air descent nor the tare
+would ever come.
+
 The fall counts only once the free-air descent is at least
 ``contact_fall_air_travel_m``: the tip went down with nothing answering,
 so the level is what the sensor reads in free air. A gate armed inside a
@@ -71,10 +80,18 @@ from vic_drake.estimation.online.params import OnlineEstimatorParams
 #: Entries of the gate's state: the filtered force, N (NaN before the
 #: first sample); the level the contact rose from, N (NaN: not armed);
 #: the phase; the free-air descent, m; the tip's highest point since
-#: armed, m (NaN: not armed); the tare, N (at :data:`TARE`).
-GATE_SIZE = 6
+#: armed, m (NaN: not armed); the tare, N (at :data:`TARE`); the time
+#: since the filter (re)started from a raw sample, s.
+GATE_SIZE = 7
 #: Offset of the tare in the gate's state, N (0 until a free-air level).
 TARE = 5
+_AGE = 6
+#: The filter settles this many ``latch_rise_filter_s`` after it starts
+#: from a raw sample (the first, or the first after a gap): e^-3, 5 % of
+#: that sample's noise, is left. Until then the level, the descent and
+#: the fall wait: one noisy sample would otherwise set a level that the
+#: filtered force never comes back to.
+SETTLE_TIME_CONSTANTS = 3.0
 #: The filter takes at most this step of the force from one sample, N: a
 #: spike (tens of N for a sample) would otherwise move the level that a
 #: contact rises from, and its decay would read as a rise.
@@ -87,7 +104,7 @@ _DISARMED = [math.nan, OUT, 0.0, math.nan, 0.0]  # the gate's state but the forc
 
 def gate_initial_state() -> list[float]:
     """A gate before its first sample."""
-    return [math.nan, *_DISARMED]
+    return [math.nan, *_DISARMED, 0.0]
 
 
 def advance_gate(
@@ -118,14 +135,20 @@ def advance_gate(
     f = g[i]
     if tau == 0.0 or f != f or not 0.0 < dt <= p.max_gap_s:  # (f != f: NaN)
         f = force
+        g[i + _AGE] = 0.0
     else:  # A spike moves the filter as a step of MAX_STEP_N would.
         step = force - f
         step = -MAX_STEP_N if step < -MAX_STEP_N else min(step, MAX_STEP_N)
         f += dt / (tau + dt) * step
+        g[i + _AGE] += dt
     g[i] = f
     if force <= threshold and f <= threshold:
-        g[i + 1 : i + GATE_SIZE] = _DISARMED
+        g[i + 1 : i + _AGE] = _DISARMED
         return OUT
+    if g[i + _AGE] < SETTLE_TIME_CONSTANTS * tau:  # Armed, not yet settled.
+        if g[i + 2] == OUT:
+            g[i + 2] = ONSET
+        return g[i + 2]
     if not z <= g[i + 4]:  # The highest tip since the gate was armed.
         g[i + 4] = z
     phase = g[i + 2]
