@@ -178,10 +178,12 @@ def test_scan_prints_the_campaigns_metrics_beside_its_own(tmp_path, capsys):
     assert main(argv) == 0
     out = json.loads(capsys.readouterr().out)
     assert list(out)[: len(SCAN_KEYS)] == SCAN_KEYS
-    assert list(out)[len(SCAN_KEYS) : len(SCAN_KEYS) + 2] == [
+    assert list(out)[len(SCAN_KEYS) : len(SCAN_KEYS) + 3] == [
         "scan_window_s",
         "campaign_metrics",
+        "watchdog_channel",
     ]
+    assert out["watchdog_channel"] is None
     campaign = out["campaign_metrics"]
     assert set(METRIC_KEYS) <= set(campaign)
     assert campaign["force_limit_N"] == 15.0
@@ -366,3 +368,19 @@ def test_compare_real_says_what_it_assumed_of_the_phantom():
     assert "against the nominal log); its motion is replayed" in moved
     assert "surface: the map offset by +3.75 mm (rig default)" in moved
     assert "contact lost: 0.34 s simulated, 0.43 s real, 0.34 s of it" in moved
+
+
+def test_scan_says_when_the_sensor_watchdog_stopped_it(tmp_path, capsys):
+    from vic_drake.experiments import synthetic_scenario
+    from vic_drake.scenario import save_scenario
+
+    scenario = synthetic_scenario("cf")
+    scenario.variations.sensor_faults.stuck_channel = 2
+    path = save_scenario(scenario, tmp_path / "stuck.yaml")
+    assert main(["scan", str(path), "--duration", "0.5", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["watchdog_channel"] == "z"
+    assert 0.05 <= out["campaign_metrics"]["watchdog_trip_s"] <= 0.1
+    assert main(["scan", str(path), "--duration", "0.5"]) == 0
+    text = capsys.readouterr().out
+    assert "sensor watchdog: the z force channel stuck; the scan stopped at" in text

@@ -104,14 +104,24 @@ def test_breathing_moves_the_phantom_and_a_stuck_sensor_shows_in_the_force():
     t = df["t_s"].to_numpy()
     expected = 0.01 * 0.5 * (1 - np.cos(2 * np.pi * 0.33 * t))
     np.testing.assert_allclose(df["phantom_lift_m"], expected, atol=5e-4)
-    # CF with its z reading stuck at ~0 from the start sees no force and
-    # pushes on: the true force on the patient (the metric) rises well
-    # above the fault-free run's; the run does not raise.
+    # CF with its z reading stuck at ~0 from the start sees no force and,
+    # without the sensor watchdog, pushes on: the true force on the patient
+    # (the metric) rises well above the fault-free run's; the run does not
+    # raise. With the watchdog (the default) the stuck channel stops the
+    # scan before the probe reaches the chest.
     stuck = synthetic_scenario("cf")
     stuck.trajectory = _short().trajectory
     ok = synthetic_scenario("cf")
     ok.trajectory = _short().trajectory
     stuck.variations.sensor_faults.stuck_channel = 2
-    f_stuck = run_scan(stuck, duration_s=1.5).df["force_tissue_z_N"].max()
+    watched = run_scan(stuck, duration_s=1.5)
+    stuck.watchdog.enabled = False
+    unwatched = run_scan(stuck, duration_s=1.5)
     f_ok = run_scan(ok, duration_s=1.5).df["force_tissue_z_N"].max()
-    assert f_stuck > 1.5 * f_ok
+    assert unwatched.df["force_tissue_z_N"].max() > 1.5 * f_ok
+    assert np.isnan(unwatched.watchdog_trip_s) and unwatched.watchdog_channel == -1
+    assert watched.watchdog_channel == 2
+    assert 0.05 <= watched.watchdog_trip_s <= 0.1
+    assert watched.df["force_tissue_z_N"].max() < 0.1
+    z = watched.df["z_m"].to_numpy()
+    assert z[-1] > z[0] + 0.02  # Lifted away.

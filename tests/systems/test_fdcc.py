@@ -192,3 +192,80 @@ def test_closed_loop_force_target_on_the_phantom():
     assert f_tissue == pytest.approx(7.0, abs=0.4)
     p = station.GetOutputPort("probe.position").Eval(context)
     np.testing.assert_allclose(p[:2], xy, atol=1e-3)
+
+
+def test_a_stuck_force_channel_trips_the_watchdog_and_the_tick_retracts(q_start):
+    from vic_drake.control.watchdog import (
+        TRIP_POSITION,
+        TRIP_TIME,
+        TRIPPED,
+        SensorWatchdogParams,
+    )
+
+    watchdog = SensorWatchdogParams()
+    system = FdccController(
+        FdccParams(),
+        station_params=StationParams(),
+        initial_q=q_start,
+        watchdog=watchdog,
+    )
+    assert system.GetOutputPort("watchdog").size() == 12
+    context = system.CreateDefaultContext()
+    rng = np.random.default_rng(0)
+    window = watchdog.window_ticks(FdccParams().period_s)
+    for k in range(window + 1):  # z keeps -1 N while x, y change.
+        context.SetTime(0.002 * k)
+        force = (0.05 * rng.standard_normal(), 0.05 * rng.standard_normal(), -1.0)
+        _fix_inputs(system, context, q_start, force=force)
+        context.SetDiscreteState(system.EvalUniquePeriodicDiscreteUpdate(context))
+        tripped = system.get_watchdog_output_port().Eval(context)[TRIPPED]
+        assert tripped == (1.0 if k == window else 0.0)
+    state = system.get_watchdog_output_port().Eval(context)
+    assert state[TRIP_TIME] == pytest.approx(0.002 * window)
+    np.testing.assert_allclose(
+        state[TRIP_POSITION], system.model.pose(q_start).translation()
+    )
+    # The next tick reads neither the sensor nor the stiffness and targets
+    # of its inputs: it is the pure step towards the retract target.
+    q_prev = system.get_position_command_output_port().Eval(context).copy()
+    internal = context.get_discrete_state(1).get_value().copy()
+    context.SetTime(0.002 * (window + 1))
+    _fix_inputs(system, context, q_start, force=(9.0, 9.0, 9.0))
+    context.SetDiscreteState(system.EvalUniquePeriodicDiscreteUpdate(context))
+    expected = fdcc_step(
+        system.model,
+        system.params,
+        q_measured=q_start,
+        q_command_prev=q_prev,
+        qdot=internal[:6],
+        last_error=internal[6:],
+        p_WP_target=state[TRIP_POSITION] + [0, 0, 0.03 * 0.002],
+        stiffness=[1000.0] * 3,
+        measured_force=[0.0] * 3,
+        target_force=[0.0] * 3,
+    )
+    np.testing.assert_allclose(
+        system.get_position_command_output_port().Eval(context),
+        expected.q_command,
+        atol=1e-15,
+    )
+
+
+def test_without_a_watchdog_a_stuck_channel_is_followed(q_start):
+    from vic_drake.control.watchdog import SensorWatchdogParams
+
+    for watchdog in (None, SensorWatchdogParams(enabled=False)):
+        system = FdccController(
+            FdccParams(),
+            station_params=StationParams(),
+            initial_q=q_start,
+            watchdog=watchdog,
+        )
+        context = system.CreateDefaultContext()
+        rng = np.random.default_rng(0)
+        for k in range(60):
+            context.SetTime(0.002 * k)
+            force = (0.05 * rng.standard_normal(), 0.05 * rng.standard_normal(), -1.0)
+            _fix_inputs(system, context, q_start, force=force)
+            context.SetDiscreteState(system.EvalUniquePeriodicDiscreteUpdate(context))
+        assert system.get_watchdog_output_port().Eval(context)[6] == 0.0

@@ -63,7 +63,9 @@ def scan_metrics_dict(scenario, result, path: Path, force_limit_N=None) -> dict:
     """The scan command's result: its metrics, then the campaign's.
 
     The first keys are the command's documented output (unchanged);
-    ``scan_window_s`` (null without one) and ``campaign_metrics`` follow.
+    ``scan_window_s`` (null without one), ``campaign_metrics`` and
+    ``watchdog_channel`` ("x", "y" or "z": the stuck force channel that
+    stopped the scan; null if none did) follow.
     """
     import numpy as np
 
@@ -81,7 +83,13 @@ def scan_metrics_dict(scenario, result, path: Path, force_limit_N=None) -> dict:
         limit_source = "--force-limit"
     tank = has_tank(scenario.controller.reference)
     with np.errstate(all="ignore"):
-        campaign = run_metrics(df, force_limit_N=force_limit_N, has_tank=tank)
+        campaign = run_metrics(
+            df,
+            force_limit_N=force_limit_N,
+            has_tank=tank,
+            stop_s=result.watchdog_trip_s,
+        )
+    campaign["watchdog_trip_s"] = result.watchdog_trip_s
     campaign["tank_floor_J"] = (
         float(scenario.controller.tank.min_energy_J) if tank else float("nan")
     )
@@ -105,6 +113,10 @@ def scan_metrics_dict(scenario, result, path: Path, force_limit_N=None) -> dict:
         if window.any()
         else None,
         "campaign_metrics": campaign,
+        # The stuck force channel that stopped the scan (null: none did).
+        "watchdog_channel": "xyz"[result.watchdog_channel]
+        if result.watchdog_channel >= 0
+        else None,
     }
 
 
@@ -153,6 +165,12 @@ def scan_human_summary(out: dict, scenario) -> str:
         )
     else:
         lines.append("contact losses: none")
+    if out.get("watchdog_channel") is not None:
+        lines.append(
+            f"sensor watchdog: the {out['watchdog_channel']} force channel stuck; "
+            f"the scan stopped at {c['watchdog_trip_s']:.3f} s and the probe "
+            "lifted away (contact losses are counted up to then)"
+        )
     tank = (
         f"tank minimum {fmt_number(out['tank_min_J'])} J (floor {c['tank_floor_J']:g} J)"
         if math.isfinite(c["tank_floor_J"])

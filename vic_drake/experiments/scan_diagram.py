@@ -188,7 +188,12 @@ def MakeScanDiagram(
     )
     fdcc = builder.AddNamedSystem(
         "fdcc",
-        FdccController(scenario.fdcc, station_params=scenario.station, initial_q=q0),
+        FdccController(
+            scenario.fdcc,
+            station_params=scenario.station,
+            initial_q=q0,
+            watchdog=scenario.watchdog,
+        ),
     )
     target = builder.AddNamedSystem(
         "target", TargetTrajectorySource(scenario.trajectory)

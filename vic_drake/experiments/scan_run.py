@@ -8,6 +8,7 @@ and returns the logs as a DataFrame of the canonical columns
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 
@@ -15,6 +16,7 @@ import pandas as pd
 from pydrake.common import RandomGenerator
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
 
+from vic_drake.control.watchdog import STUCK_CHANNEL, TRIP_TIME
 from vic_drake.errors import VicDrakeError
 from vic_drake.experiments.rig_log import rig_frame
 from vic_drake.experiments.scan_diagram import (
@@ -46,6 +48,10 @@ class ScanResult:
             (:data:`vic_drake.analysis.rig_layout.RIG_SIGNALS`; ``attrs``
             "beta": the phantom's exponent); see
             :func:`vic_drake.experiments.rig_log.rig_log_rows`.
+        watchdog_trip_s: when the force sensor's watchdog tripped and the
+            probe began to lift away, s (NaN: it did not, or it is off).
+        watchdog_channel: the stuck force channel that tripped it (0, 1, 2
+            for x, y, z; -1 if none).
     """
 
     df: pd.DataFrame
@@ -56,6 +62,8 @@ class ScanResult:
     build_s: float = 0.0
     cpu_s: float = float("nan")
     rig: pd.DataFrame | None = None
+    watchdog_trip_s: float = math.nan
+    watchdog_channel: int = -1
 
 
 def run_scan(
@@ -119,7 +127,10 @@ def run_scan(
     wall = time.perf_counter() - t0
     cpu = time.process_time() - c0
     df = logs_to_frame(logs, context)
-    df.attrs.update(source="sim", scenario=scenario.name)
+    fdcc = diagram.GetSubsystemByName("fdcc")
+    watch = fdcc.watchdog_state(fdcc.GetMyContextFromRoot(context))
+    trip_s, channel = float(watch[TRIP_TIME]), int(watch[STUCK_CHANNEL])
+    df.attrs.update(source="sim", scenario=scenario.name, watchdog_trip_s=trip_s)
     rig = rig_frame(logs, context)
     rig.attrs["beta"] = float(phantom.beta)
     return ScanResult(
@@ -131,6 +142,8 @@ def run_scan(
         build_s=build_s,
         cpu_s=cpu,
         rig=rig,
+        watchdog_trip_s=trip_s,
+        watchdog_channel=channel,
     )
 
 

@@ -23,6 +23,7 @@ from vic_drake.control.params import (
     ReferenceParams,
     StiffnessQpParams,
 )
+from vic_drake.control.watchdog import SensorWatchdogParams
 from vic_drake.errors import VicDrakeError, check_number
 from vic_drake.estimation.online import OnlineEstimatorParams
 from vic_drake.scenario.disturbance import DisturbanceConfig
@@ -140,6 +141,9 @@ class Scenario:
         fdcc: the forward-dynamics compliance controller that turns
             stiffness and target force into joint position commands
             (default FdccParams(): pose error on the measured joints).
+        watchdog: the force sensor's watchdog in the compliance stage (on by
+            default: a stuck force channel stops the scan and lifts the
+            probe; see :mod:`vic_drake.control.watchdog`).
         trajectory: the target x_d(t).
         disturbance: the phantom lift z_offset(t).
         logging: recording period.
@@ -157,6 +161,9 @@ class Scenario:
     station: StationParams = field(default_factory=StationParams)
     controller: ControllerParams = field(default_factory=_vs_vf_controller)
     fdcc: FdccParams = field(default_factory=FdccParams)
+    # The force sensor's watchdog: a channel stuck while the others change
+    # stops the scan and lifts the probe (enabled: false turns it off).
+    watchdog: SensorWatchdogParams = field(default_factory=SensorWatchdogParams)
     trajectory: TrajectoryConfig = field(default_factory=TrajectoryConfig)
     disturbance: DisturbanceConfig = field(default_factory=DisturbanceConfig)
     logging: LoggingConfig = field(default_factory=LoggingConfig)
@@ -199,6 +206,7 @@ class Scenario:
             ("station", StationParams),
             ("controller", ControllerParams),
             ("fdcc", FdccParams),
+            ("watchdog", SensorWatchdogParams),
             ("trajectory", TrajectoryConfig),
             ("disturbance", DisturbanceConfig),
             ("logging", LoggingConfig),

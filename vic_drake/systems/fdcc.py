@@ -16,6 +16,14 @@ from pydrake.systems.framework import LeafSystem
 from pydrake.systems.primitives import Multiplexer
 
 from vic_drake.control.fdcc import FdccConstants, FdccModel, FdccParams, fdcc_tick
+from vic_drake.control.watchdog import (
+    TRIPPED,
+    SensorWatchdogParams,
+    initial_watchdog_state,
+    record_trip,
+    retract_target,
+    watch_reading,
+)
 from vic_drake.errors import VicDrakeError
 from vic_drake.models.ur3e import MakeFdccModel
 from vic_drake.systems.signals import (
@@ -51,15 +59,29 @@ class FdccController(LeafSystem):
         status (2): (fault on the last tick, number of faulted ticks). A
             fault -- a non-finite input or result, or a negative stiffness --
             holds the previous command and zeroes the internal velocity.
+        watchdog (12, ``control.watchdog.WATCHDOG_FIELDS``): the force
+            sensor's watchdog (all zeros but the NaN fields when disabled).
 
     State (discrete, updated every ``period_s``): the command q (6), the
-    internal velocity (6) and the PD's last error (6), and the status (2).
+    internal velocity (6) and the PD's last error (6), the status (2) and
+    the watchdog (12).
+
+    With a watchdog (``watchdog.enabled``), a force channel that keeps its
+    value while the others change trips it (:mod:`vic_drake.control.watchdog`);
+    from then on the tick ignores the sensor, the stiffness and the targets
+    of its inputs and lifts the probe away from the tissue
+    (:func:`~vic_drake.control.watchdog.retract_target`).
 
     The settings are read once, at construction.
     """
 
     def __init__(
-        self, params: FdccParams | None = None, *, station_params, initial_q=None
+        self,
+        params: FdccParams | None = None,
+        *,
+        station_params,
+        initial_q=None,
+        watchdog: SensorWatchdogParams | None = None,
     ):
         """
         Args:
@@ -68,6 +90,8 @@ class FdccController(LeafSystem):
                 model, a :class:`vic_drake.station.StationParams` (required:
                 this layer does not import the station).
             initial_q: default command, rad (6,); set it to the arm's start.
+            watchdog: the force sensor's watchdog (default: none; the scan
+                diagram passes the scenario's).
         """
         super().__init__()
         self._params = params or FdccParams()
@@ -83,10 +107,22 @@ class FdccController(LeafSystem):
             raise VicDrakeError(
                 f"initial_q must be 6 finite joint angles (rad), got {initial_q!r}"
             )
+        if watchdog is not None and not isinstance(watchdog, SensorWatchdogParams):
+            raise VicDrakeError(
+                f"watchdog must be SensorWatchdogParams or None, got {watchdog!r}"
+            )
+        self._watchdog = (
+            watchdog.validate() if watchdog is not None and watchdog.enabled else None
+        )
+        if self._watchdog is not None:
+            self._window = self._watchdog.window_ticks(self._params.period_s)
+            k = self._watchdog.retract_stiffness_N_per_m
+            self._retract_stiffness = np.array([k, k, k])
         self._inputs_port = self.DeclareVectorInputPort("inputs", FDCC_INPUTS_SIZE)
         self._q_cmd = self.DeclareDiscreteState(q0)
         self._internal = self.DeclareDiscreteState(12)
         self._status = self.DeclareDiscreteState(2)
+        self._watch = self.DeclareDiscreteState(initial_watchdog_state())
         self.DeclarePeriodicDiscreteUpdateEvent(
             self._params.period_s, 0.0, self._update
         )
@@ -94,7 +130,13 @@ class FdccController(LeafSystem):
             "position_command", self._q_cmd
         )
         self._status_port = self.DeclareStateOutputPort("status", self._status)
-        self._groups = (int(self._q_cmd), int(self._internal), int(self._status))
+        self._watchdog_port = self.DeclareStateOutputPort("watchdog", self._watch)
+        self._groups = (
+            int(self._q_cmd),
+            int(self._internal),
+            int(self._status),
+            int(self._watch),
+        )
 
     @property
     def params(self) -> FdccParams:
@@ -114,6 +156,13 @@ class FdccController(LeafSystem):
     def get_status_output_port(self):
         return self._status_port
 
+    def get_watchdog_output_port(self):
+        return self._watchdog_port
+
+    def watchdog_state(self, context) -> np.ndarray:
+        """A copy of the watchdog's state (``control.watchdog.WATCHDOG_SIZE``) in ``context``."""
+        return np.array(context.get_discrete_state(self._watch).get_value())
+
     def set_initial_command(self, context, q) -> None:
         """Sets the command state to q (6,), rad, with zero internal motion."""
         q = np.asarray(q, float)
@@ -125,19 +174,35 @@ class FdccController(LeafSystem):
     def _update(self, context, discrete_state):
         # Drake fills discrete_state with the current state before calling
         # this handler: each group is read and written in place.
-        command, internal, status = map(discrete_state.get_mutable_value, self._groups)
+        command, internal, status, watch = map(
+            discrete_state.get_mutable_value, self._groups
+        )
         u = self._inputs_port.Eval(context)
+        q = u[FDCC_IN_JOINT_POSITIONS]
+        x_d = u[FDCC_IN_TARGET_POSITION]
+        stiffness = u[FDCC_IN_STIFFNESS]
+        force = u[FDCC_IN_FORCE]
+        target_force = u[FDCC_IN_TARGET_FORCE]
+        if self._watchdog is not None:
+            channel = watch_reading(watch, force, self._window)
+            if channel >= 0:
+                t = context.get_time()
+                record_trip(watch, channel, t, self._model.pose(q).translation())
+            if watch[TRIPPED] >= 0.5:  # The sensor is not read again.
+                x_d = retract_target(watch, context.get_time(), self._watchdog)
+                stiffness = self._retract_stiffness
+                force = target_force = _ZERO3
         result = fdcc_tick(
             self._model,
             self._constants,
-            u[FDCC_IN_JOINT_POSITIONS],
+            q,
             command,
             internal[:6],
             internal[6:],
-            u[FDCC_IN_TARGET_POSITION],
-            u[FDCC_IN_STIFFNESS],
-            u[FDCC_IN_FORCE],
-            u[FDCC_IN_TARGET_FORCE],
+            x_d,
+            stiffness,
+            force,
+            target_force,
         )
         if result is None:  # Hold the command, stop the internal motion.
             internal[:] = 0.0
@@ -149,6 +214,9 @@ class FdccController(LeafSystem):
             internal[:] = qd + err
             status[0] = 0.0
             status[1] = status[1] + 0.0
+
+
+_ZERO3 = np.zeros(3)
 
 
 def AddFdccInputs(builder, fdcc: FdccController, *, name: str = "fdcc_inputs"):

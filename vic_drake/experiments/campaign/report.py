@@ -158,6 +158,7 @@ def summary_html(
                 "95 % interval (Wilson)",
                 "contact loss p50 (s)",
                 "tank min (J)",
+                "stopped by the sensor watchdog",
             ],
             [
                 [
@@ -169,6 +170,7 @@ def summary_html(
                     _fmt(v["exceed_prob_ci95"]),
                     _fmt(v["contact_loss_s_p50"]),
                     _fmt(v["tank_min_J"]),
+                    v.get("watchdog_stops", 0),
                 ]
                 for n, v in pc.items()
             ],

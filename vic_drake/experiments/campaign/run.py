@@ -34,25 +34,35 @@ METRIC_KEYS = (
     "tank_min_J",
     "tank_floor_J",
     "qp_failures",
+    "watchdog_trip_s",
 )
 
 
 def run_metrics(
-    df: pd.DataFrame, *, force_limit_N: float, has_tank: bool = True
+    df: pd.DataFrame,
+    *,
+    force_limit_N: float,
+    has_tank: bool = True,
+    stop_s: float = math.nan,
 ) -> dict:
     """The safety metrics of one run's log.
 
     The force is the tissue's force on the probe (``force_tissue_z_N``, the
     force on the patient, not what a faulty sensor reports). Contact losses
     are :func:`vic_drake.analysis.contact.contact_loss_intervals` inside the
-    scan window. ``qp_failures`` counts logged samples with ``qp_ok`` = 0.
+    scan window, which ends at ``stop_s`` when that is finite (the time the
+    force sensor's watchdog stopped the scan: the retract after it is the
+    stop, not a loss of contact). ``qp_failures`` counts logged samples with ``qp_ok`` = 0.
     ``tank_min_J`` is NaN for a controller without a tank (``has_tank``
     False: CS, CF).
     """
     t = df["t_s"].to_numpy(float)
     f = df["force_tissue_z_N"].to_numpy(float)
     dt = np.diff(t, append=t[-1] + (t[-1] - t[-2] if t.size > 1 else 0.0))
-    losses = contact_loss_intervals(df, window=scan_window(df))
+    window = scan_window(df)
+    if math.isfinite(stop_s):
+        window &= t < stop_s
+    losses = contact_loss_intervals(df, window=window)
     qp_ok = df["qp_ok"].to_numpy(float)
     return {
         "peak_force_N": float(np.nanmax(f)),
@@ -76,7 +86,8 @@ def execute_run(plan: RunPlan) -> dict:
     Returns:
         A row: run_id, index, status ("ok" | "nan" | "error"), error (text,
         "" when ok), the sampled factors (``factor.<name>``), the metrics of
-        :data:`METRIC_KEYS`, sim_s and wall_s; and ``_scenario_yaml``, the
+        :data:`METRIC_KEYS` (``watchdog_trip_s``: when the force sensor's
+        watchdog stopped the scan, NaN if it did not), sim_s and wall_s; and ``_scenario_yaml``, the
         run's exact scenario, which the engine stores beside the row.
     """
     # Imported here: a worker process pays pydrake's import on its first run.
@@ -98,7 +109,15 @@ def execute_run(plan: RunPlan) -> dict:
         df = result.df
         bad = _nan_columns(df)
         with np.errstate(all="ignore"):
-            row.update(run_metrics(df, force_limit_N=plan.force_limit_N, has_tank=tank))
+            row.update(
+                run_metrics(
+                    df,
+                    force_limit_N=plan.force_limit_N,
+                    has_tank=tank,
+                    stop_s=result.watchdog_trip_s,
+                )
+            )
+        row["watchdog_trip_s"] = result.watchdog_trip_s
         if bad:
             row["status"] = "nan"
             first = float(

@@ -40,8 +40,16 @@ def _stat(values, fn) -> float:
     return float(fn(v)) if v.size else math.nan
 
 
+def _count_finite(rows: pd.DataFrame, column: str) -> int:
+    """Rows with a finite ``column`` (0 for rows written before it existed)."""
+    if column not in rows:
+        return 0
+    return int(np.isfinite(pd.to_numeric(rows[column], errors="coerce")).sum())
+
+
 def per_controller(rows: pd.DataFrame, force_limit_N: float) -> dict:
-    """{controller: runs, peak force p50/max, exceedance and CI, contact loss, tank min}.
+    """{controller: runs, peak force p50/max, exceedance and CI, contact loss,
+    tank min, runs the sensor's watchdog stopped}.
 
     Runs with status "error" count in ``runs`` but not in the statistics;
     a NaN run's peak force is its finite part's maximum (its row says NaN).
@@ -64,6 +72,7 @@ def per_controller(rows: pd.DataFrame, force_limit_N: float) -> dict:
             "exceed_prob_ci95": [lo, hi],
             "contact_loss_s_p50": _stat(scored["contact_loss_s"], np.median),
             "tank_min_J": _stat(scored["tank_min_J"], np.min),
+            "watchdog_stops": _count_finite(scored, "watchdog_trip_s"),
         }
     return out
 

@@ -1,0 +1,194 @@
+"""The force sensor's watchdog: a stuck channel, and the retract it triggers.
+
+A live force/torque sensor never repeats a channel's exact value for long:
+its noise moves the last digits every sample. In the rig's twelve logs the
+longest run of identical force samples is 6 (10 ms at 500 Hz), and in the two
+logs with all three channels no channel ever repeats while another changes:
+the repeats are whole samples (the logger read the same sample twice). A
+channel that keeps one value while the other channels of the same
+reading change is stuck: a frozen converter or a broken wire, and the force
+loop on it presses on without feeling the tissue. The fault campaigns draw
+such a channel in about one run in seven, and every force above 15 N in
+them came from one (docs/decisions.md, "The sensor watchdog").
+
+:func:`watch_reading` counts, for each channel, the ticks in which it kept
+its value while another channel changed ("live" ticks). A channel trips the
+watchdog after ``stuck_window_s`` of live ticks. Ticks in which nothing
+changed (a held dropout, a repeated sample, a sensor at rest with no noise)
+neither count nor reset the run; a non-finite reading is skipped.
+
+Once tripped the watchdog latches, and the compliance stage stops using the
+sensor: :func:`retract_target` moves the target up from the probe's position
+at the trip at ``retract_speed_m_per_s`` to ``retract_height_m`` above it,
+tracked with ``retract_stiffness_N_per_m`` and no force term, and holds
+there. The scan is over; the operator restarts it on a working sensor.
+
+(No ``from __future__ import annotations`` here: :class:`SensorWatchdogParams`
+is loaded by ``yaml_load_typed``, which reads the field types at run time.)
+"""
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from vic_drake.errors import VicDrakeError
+
+#: Layout of the watchdog's state vector (``WATCHDOG_SIZE`` numbers).
+LAST = slice(0, 3)  # The last finite reading, N.
+LIVE_RUN = slice(3, 6)  # Per channel: live ticks it has kept its value.
+TRIPPED = 6  # 1 once tripped (latched), else 0.
+TRIP_TIME = 7  # When it tripped, s (NaN before).
+TRIP_POSITION = slice(8, 11)  # The probe tip at the trip, W, m (NaN before).
+STUCK_CHANNEL = 11  # The channel that tripped it (0, 1, 2; -1 before).
+WATCHDOG_SIZE = 12
+#: Names of the state's elements, in order (for logs and tests).
+WATCHDOG_FIELDS = (
+    "last_x",
+    "last_y",
+    "last_z",
+    "live_run_x",
+    "live_run_y",
+    "live_run_z",
+    "tripped",
+    "trip_time",
+    "trip_x",
+    "trip_y",
+    "trip_z",
+    "stuck_channel",
+)
+
+
+@dataclass
+class SensorWatchdogParams:
+    """Settings of the force sensor's watchdog (see the module docstring)."""
+
+    # Watch the sensor and retract on a stuck channel.
+    enabled: bool = True
+    # Live time a channel may keep one value before it counts as stuck, s
+    # (the rig's longest run of repeated samples spans 0.010 s).
+    stuck_window_s: float = 0.05
+    # Speed of the retract, m/s (above the 0.015 m/s a 15 mm breath at
+    # 0.33 Hz lifts the chest at).
+    retract_speed_m_per_s: float = 0.03
+    # How far the retract lifts the target above the probe at the trip, m.
+    retract_height_m: float = 0.03
+    # Stiffness that tracks the retract target, N/m, each axis.
+    retract_stiffness_N_per_m: float = 1000.0
+
+    def __post_init__(self):
+        self.validate()
+
+    def validate(self) -> "SensorWatchdogParams":
+        """Checks every field; raises VicDrakeError naming the bad one. Returns self."""
+        o = "SensorWatchdogParams"
+        if not isinstance(self.enabled, bool):
+            raise VicDrakeError(
+                f"{o}.enabled must be true or false; got {self.enabled!r}"
+            )
+        for name in (
+            "stuck_window_s",
+            "retract_speed_m_per_s",
+            "retract_height_m",
+            "retract_stiffness_N_per_m",
+        ):
+            value = getattr(self, name)
+            if (
+                isinstance(value, bool)
+                or not isinstance(value, (int, float))
+                or not math.isfinite(value)
+                or value <= 0
+            ):
+                raise VicDrakeError(
+                    f"{o}.{name} must be a finite number > 0; got {value!r}"
+                )
+        return self
+
+    def window_ticks(self, period_s: float) -> int:
+        """The stuck window in controller ticks (at least 2)."""
+        return max(2, int(math.ceil(self.stuck_window_s / period_s - 1e-9)))
+
+
+def initial_watchdog_state() -> np.ndarray:
+    """The state of a watchdog that has seen nothing."""
+    x = np.zeros(WATCHDOG_SIZE)
+    x[LAST] = np.nan
+    x[TRIP_TIME] = np.nan
+    x[TRIP_POSITION] = np.nan
+    x[STUCK_CHANNEL] = -1.0
+    return x
+
+
+def watch_reading(state: np.ndarray, reading, window_ticks: int) -> int:
+    """Advances the watchdog by one reading, in place.
+
+    Args:
+        state: the watchdog's state (:data:`WATCHDOG_SIZE`), updated in place.
+            A tripped state is left as it is.
+        reading: (3,) the force reading of this tick, N.
+        window_ticks: live ticks after which a kept value is stuck.
+
+    Returns:
+        The channel (0, 1, 2) that trips the watchdog at this reading, or -1
+        (no trip now, or tripped before). The caller records the trip's time
+        and position (:func:`record_trip`).
+    """
+    if state[TRIPPED] >= 0.5:
+        return -1
+    f0, f1, f2 = float(reading[0]), float(reading[1]), float(reading[2])
+    if not (math.isfinite(f0) and math.isfinite(f1) and math.isfinite(f2)):
+        return -1
+    l0, l1, l2 = state[0], state[1], state[2]
+    state[0], state[1], state[2] = f0, f1, f2
+    if math.isnan(l0) or math.isnan(l1) or math.isnan(l2):
+        return -1  # The first finite reading: nothing to compare with.
+    same = (f0 == l0, f1 == l1, f2 == l2)
+    if all(same):
+        return -1  # Nothing changed: a repeated sample; no evidence either way.
+    tripped = -1
+    for c in range(3):
+        if same[c]:
+            state[3 + c] += 1.0
+            if tripped < 0 and state[3 + c] >= window_ticks:
+                tripped = c
+        else:
+            state[3 + c] = 0.0
+    return tripped
+
+
+def record_trip(state: np.ndarray, channel: int, t_s: float, tip_W) -> None:
+    """Latches the trip of ``channel`` at ``t_s`` with the probe tip at ``tip_W``."""
+    state[TRIPPED] = 1.0
+    state[TRIP_TIME] = float(t_s)
+    state[TRIP_POSITION] = np.asarray(tip_W, float).reshape(3)
+    state[STUCK_CHANNEL] = float(channel)
+
+
+def retract_target(
+    state: np.ndarray, t_s: float, params: SensorWatchdogParams
+) -> np.ndarray:
+    """The target position of a tripped watchdog at ``t_s``, W, m.
+
+    The probe's position at the trip, raised at the retract speed up to the
+    retract height, then held.
+    """
+    lift = min(
+        params.retract_speed_m_per_s * max(0.0, t_s - state[TRIP_TIME]),
+        params.retract_height_m,
+    )
+    target = np.array(state[TRIP_POSITION], float)
+    target[2] += lift
+    return target
+
+
+__all__ = [
+    "STUCK_CHANNEL",
+    "SensorWatchdogParams",
+    "TRIP_TIME",
+    "WATCHDOG_FIELDS",
+    "WATCHDOG_SIZE",
+    "initial_watchdog_state",
+    "record_trip",
+    "retract_target",
+    "watch_reading",
+]
