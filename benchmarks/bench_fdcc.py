@@ -4,7 +4,10 @@ Prints the median and 90th percentile wall time per call, in microseconds,
 of
 
 - ``FdccController._update`` on a fixed context (inputs fixed, the discrete
-  state copied in as Drake does before calling the handler);
+  state copied in as Drake does before calling the handler), without and
+  with the force sensor's watchdog (two contexts whose force readings
+  differ, called in turn, so that the watchdog compares changing readings
+  as on a live sensor), and the watchdog's ``watch_reading`` alone;
 - ``EvalUniquePeriodicDiscreteUpdate`` (the same plus Drake's event
   dispatch and a fresh DiscreteValues; the context time is nudged before
   each call so that the cached result is not reused);
@@ -33,16 +36,23 @@ import numpy as np
 from pydrake.multibody.tree import JacobianWrtVariable
 
 from vic_drake.control.fdcc import FdccConstants, FdccParams, fdcc_step, fdcc_tick
+from vic_drake.control.watchdog import (
+    SensorWatchdogParams,
+    initial_watchdog_state,
+    watch_reading,
+)
 from vic_drake.station import StationParams, initial_q_for_tip
 from vic_drake.systems.fdcc import FdccController
-from vic_drake.systems.signals import FDCC_INPUT_PARTS, FDCC_INPUTS_SIZE
+from vic_drake.systems.signals import FDCC_IN_FORCE, FDCC_INPUT_PARTS, FDCC_INPUTS_SIZE
 
 START = np.array([-0.06, -0.36, 0.13])
 
 
-def _controller():
+def _controller(watchdog=None):
     q0 = initial_q_for_tip(START)
-    system = FdccController(FdccParams(), station_params=StationParams(), initial_q=q0)
+    system = FdccController(
+        FdccParams(), station_params=StationParams(), initial_q=q0, watchdog=watchdog
+    )
     context = system.CreateDefaultContext()
     inputs = {
         "joint_positions": q0 + 0.001,
@@ -92,12 +102,34 @@ def main(argv=None):
         state["k"] ^= 1
         plant.SetPositions(scratch, q_alt[state["k"]])
 
+    # The watchdog's controller on two contexts whose readings differ, one
+    # state between them: each call compares a reading that changed.
+    w_system, w_context, _, w_inputs = _controller(SensorWatchdogParams())
+    w_contexts = (w_context, w_system.CreateDefaultContext())
+    u = w_system.get_inputs_input_port().Eval(w_context).copy()
+    u[FDCC_IN_FORCE] = [0.001, 0.002, -1.001]  # Every channel differs.
+    w_system.get_inputs_input_port().FixValue(w_contexts[1], u)
+    w_state = w_system.AllocateDiscreteVariables()
+    w_state.SetFrom(w_context.get_discrete_state())
+    readings = (np.array([0.01, 0.02, -1.0]), np.array([0.02, 0.01, -1.001]))
+    watch_state = initial_watchdog_state()
+
+    def watched_update():
+        state["k"] ^= 1
+        w_system._update(w_contexts[state["k"]], w_state)
+
+    def watch():
+        state["k"] ^= 1
+        watch_reading(watch_state, readings[state["k"]], 25)
+
     def eval_update():
         context.SetTime(context.get_time() + 1e-9)
         system.EvalUniquePeriodicDiscreteUpdate(context)
 
     kinds = {
         "FdccController._update": lambda: system._update(context, discrete_state),
+        "  with the watchdog": watched_update,
+        "watch_reading": watch,
         "EvalUniquePeriodicDiscreteUpdate": eval_update,
         "fdcc_tick": lambda: fdcc_tick(
             model, constants, q_m, q0, zeros, zeros, x_d, K, f_m, f_t
@@ -126,6 +158,10 @@ def main(argv=None):
             t0 = clock()
             f()
             times[name].append(clock() - t0)
+    if w_state.get_vector(3).GetAtIndex(6) != 0.0:
+        raise SystemExit(
+            "the benchmark's watchdog tripped: its figure is not a live tick's"
+        )
     print(f"{'per call, us':36s} {'median':>8s} {'p90':>8s}   ({args.calls} calls)")
     for name, ts in times.items():
         ts.sort()

@@ -87,7 +87,8 @@ def _human(result: dict) -> str:
         f"{result['finished']}/{result['runs']} runs finished, {result['failed']} failed "
         f"({result['nan_runs']} NaN); {session}",
         f"{'controller':<{width}} {'runs':>5} {'peakF p50':>10} {'peakF max':>10} "
-        f"{'P(exceed)':>10} {'95% CI':>16} {'loss p50 s':>10} {'tank min J':>10}",
+        f"{'P(exceed)':>10} {'95% CI':>16} {'loss p50 s':>10} {'tank min J':>10} "
+        f"{'wd stops':>8}",
     ]
     for name, v in result["per_controller"].items():
         lo, hi = v["exceed_prob_ci95"]
@@ -96,7 +97,7 @@ def _human(result: dict) -> str:
             f"{name:<{width}} {v['runs']:>5} {_num(v['peak_force_N_p50'], 10, 2)} "
             f"{_num(v['peak_force_N_max'], 10, 2)} {_num(v['exceed_prob'], 10, 3)} "
             f"{ci:>16} {_num(v['contact_loss_s_p50'], 10, 3)} "
-            f"{_num(v['tank_min_J'], 10, 3)}"
+            f"{_num(v['tank_min_J'], 10, 3)} {v.get('watchdog_stops', 0):>8}"
         )
     for c in result.get("paired", []):
         loss, over = c["contact_loss"], c["exceedance"]

@@ -114,6 +114,29 @@ def test_tankless_controllers_have_nan_tank_metrics():
     assert run_metrics(df, force_limit_N=15.0)["tank_min_J"] == 0.5
 
 
+def test_contact_losses_count_up_to_the_watchdogs_stop():
+    t = np.arange(0, 6, 0.002)
+    lost = (t > 3.0) & (t < 3.5) | (t > 4.5)  # A loss, then the stop's retract.
+    df = pd.DataFrame(
+        {
+            "t_s": t,
+            "z_d_m": np.where(t < 5.5, 0.085, 0.12),
+            "force_sensor_z_N": np.where(lost, 0.0, -7.0),
+            "force_tissue_z_N": np.where(lost, 0.0, -7.0),
+            "tank_energy_J": 0.5,
+            "qp_ok": 1.0,
+        }
+    )
+    everything = run_metrics(df, force_limit_N=15.0)["contact_loss_s"]
+    stopped = run_metrics(df, force_limit_N=15.0, stop_s=4.5)["contact_loss_s"]
+    assert stopped == pytest.approx(0.5, abs=0.005)
+    assert everything == pytest.approx(0.5, abs=0.005)  # No contact after 4.5 s.
+    # A stop inside a loss ends it there.
+    assert run_metrics(df, force_limit_N=15.0, stop_s=3.2)[
+        "contact_loss_s"
+    ] == pytest.approx(0.2, abs=0.005)
+
+
 def _rows() -> pd.DataFrame:
     return pd.DataFrame(
         {
@@ -125,6 +148,7 @@ def _rows() -> pd.DataFrame:
             "peak_force_N": [7.4, 8.3, 7.1],
             "contact_loss_s": [0.0, 0.0, 0.0],
             "tank_min_J": [math.nan, math.nan, 0.444],
+            "watchdog_trip_s": [math.nan, 2.1, math.nan],
         }
     )
 
@@ -145,11 +169,14 @@ def _result(session_runs: int, finished: int = 16) -> dict:
 
 def test_the_console_table_shows_a_dash_for_no_tank():
     text = _human(_result(16))
-    cs, vs = (
+    cs, cf, vs = (
         next(line.split() for line in text.splitlines() if line.startswith(name))
-        for name in ("cs ", "vs-vf ")
+        for name in ("cs ", "cf ", "vs-vf ")
     )
-    assert cs[-1] == "-" and vs[-1] == "0.444"
+    assert cs[-2] == "-" and vs[-2] == "0.444"
+    # The last column: runs the sensor's watchdog stopped.
+    assert text.splitlines()[1].endswith("wd stops")
+    assert (cs[-1], cf[-1], vs[-1]) == ("0", "1", "0")
     assert "nan" not in "\n".join(text.splitlines()[1:])  # The table, not "0 NaN".
 
 
