@@ -38,6 +38,14 @@ def test_only_changes_dump_round_trips_and_is_short():
     assert loads_scenario(text) == scenario
 
 
+def test_the_watchdog_is_on_by_default_and_round_trips():
+    assert Scenario().watchdog.enabled
+    scenario = loads_scenario("watchdog: {enabled: false, stuck_window_s: 0.1}\n")
+    assert not scenario.watchdog.enabled
+    assert scenario.watchdog.stuck_window_s == 0.1
+    assert loads_scenario(dumps_scenario(scenario)) == scenario
+
+
 def test_simulator_config_round_trips():
     scenario = Scenario()
     scenario.simulator.target_realtime_rate = 1.0
@@ -67,6 +75,8 @@ def test_partial_yaml_keeps_defaults_and_validates_nested_values():
         ("simulator: {integration_scheme: magic}", r"simulator\.integration_scheme"),
         ("simulator: {max_step: 0.1}", r"simulator\.max_step is unknown"),
         ("simulator: {start_time: 1.0}", r"simulator\.start_time must be 0"),
+        ("watchdog: {stuck_window_s: -1}", r"SensorWatchdogParams\.stuck_window_s"),
+        ("watchdog: {enable: false}", r"watchdog\.enable is unknown"),
     ],
 )
 def test_bad_yaml_names_the_field(text, match):
