@@ -191,6 +191,28 @@ def test_a_noisy_first_sample_does_not_set_the_level(first_sample_offset_N):
     assert np.all(np.abs(tare[(t > 0.29) & (t < 1.5)] - 2.1) < 0.15)
 
 
+@pytest.mark.parametrize(
+    "method, from_slope", [("rls", False), ("ekf", False), ("ekf", True)]
+)
+@pytest.mark.parametrize("first_sample_offset_N", [-0.6, -0.45])
+def test_a_noisy_first_sample_does_not_confirm_a_latch_in_free_air(
+    method, from_slope, first_sample_offset_N
+):
+    """The surface latch's own low-pass, started from a first sample below a
+    2.1 N bias, once "rose" from it as it settled and confirmed a latch in
+    free air, before the tare: the estimator then updated on free-air
+    samples. No sample with the tip above the surface is in contact."""
+    params = OnlineEstimatorParams(
+        method=method, kappa_prior=3000.0, surface_from_slope=from_slope
+    )
+    for seed in range(5):
+        t, z, v, force, _, _ = _chest_draws_away(2.1, noise_N=0.34, seed=seed)
+        force[0] = 2.1 + first_sample_offset_N
+        trace = run_online(t, z, v, force, math.nan, params)
+        in_free_air = z > 0.1005  # the tip 0.5 mm or more above the surface
+        assert not np.any(trace.column("in_contact")[in_free_air] > 0), seed
+
+
 @pytest.mark.parametrize("bias_N", [-1.0, 0.0, 0.4])
 def test_no_tare_at_or_below_the_threshold(bias_N):
     t, z, _, force, _, _ = _chest_draws_away(bias_N)

@@ -184,6 +184,7 @@ __all__ = [
     "ONSET",
     "OUT",
     "RISEN",
+    "SETTLE_TIME_CONSTANTS",
     "TARE",
     "advance_gate",
     "gate_initial_state",

@@ -51,6 +51,7 @@ from typing import NamedTuple
 from vic_drake.estimation.online.contact import (
     FALLEN,
     GATE_SIZE,
+    SETTLE_TIME_CONSTANTS,
     TARE,
     advance_gate,
     gate_initial_state,
@@ -74,7 +75,8 @@ N_RESTORED = 11  # unconfirmed resets undone at the end of their contact
 F_FILT = 12  # the force through the latch's low-pass, N (NaN before the first)
 LATCH_F_MIN = 13  # lowest filtered force since the latch, N (NaN: no latch)
 LATCH_OK = 14  # 1 once the latched contact is confirmed by a rise of the force
-GATE = 15  # the contact gate's state (contact.GATE_SIZE entries)
+LATCH_AGE = 15  # time since the latch's low-pass (re)started from a raw sample, s
+GATE = 16  # the contact gate's state (contact.GATE_SIZE entries)
 AUX_SIZE = GATE + GATE_SIZE
 
 #: Fields of the estimator's outputs, in order (:class:`Estimate`).
@@ -116,7 +118,7 @@ def initial_state(x0: list[float], p0_diag: list[float]) -> list[float]:
     n = len(x0)
     aux = [math.nan, math.nan, math.nan, 0.0, 0.0, 0.0, 0.0, 0.0, math.nan]
     aux += [math.nan, math.nan, 0.0]  # CLIP_START, RESET_T, N_RESTORED
-    aux += [math.nan, math.nan, 0.0]  # F_FILT, LATCH_F_MIN, LATCH_OK
+    aux += [math.nan, math.nan, 0.0, 0.0]  # F_FILT, LATCH_F_MIN, LATCH_OK, LATCH_AGE
     aux += gate_initial_state()
     P = [0.0] * (n * n)
     for i in range(n):
@@ -215,13 +217,26 @@ def _latch(
     reads as contact in free air, and the estimate would read the depth
     that the probe travels as a softer tissue). ``latch_rise_filter_s`` 0:
     the latch stands at once, at the first sample.
+
+    The low-pass starts from a raw sample (the first, or the first after a
+    gap longer than ``max_gap_s``), which holds that sample's noise. Until
+    it has settled (``contact.SETTLE_TIME_CONSTANTS`` time constants) no
+    rise confirms the latch, and where it settles the lowest value is
+    raised to the settled force: a first sample a few tenths of a newton
+    below a biased reading would otherwise be a low that the filter's
+    settling "rises" from. The latched height stays where the lowest value
+    was (a log that starts pressed in keeps the height of its first
+    sample).
     """
     tau = p.latch_rise_filter_s
+    settle = SETTLE_TIME_CONSTANTS * tau
     f = aux[F_FILT]
     if math.isnan(f) or not 0.0 < dt <= p.max_gap_s:
         f = force
+        aux[LATCH_AGE] = age = 0.0
     else:
         f += dt / (tau + dt) * (force - f)
+        aux[LATCH_AGE] = age = aux[LATCH_AGE] + dt
     aux[F_FILT] = f
     if not touching:
         aux[S_LATCH] = aux[LATCH_F_MIN] = math.nan
@@ -232,6 +247,10 @@ def _latch(
     if not f >= aux[LATCH_F_MIN]:  # A new low (NaN: the latch's first sample).
         aux[LATCH_F_MIN] = f
         aux[S_LATCH] = z + (force / kappa_hat) ** (1.0 / beta)
+    if age < settle:
+        return False  # The filter still holds its first sample's noise.
+    if age - dt < settle and f > aux[LATCH_F_MIN]:  # Settled at this sample.
+        aux[LATCH_F_MIN] = f
     if tau == 0.0 or f - aux[LATCH_F_MIN] >= p.contact_threshold_N:
         aux[LATCH_OK] = 1.0
         return True
