@@ -97,7 +97,7 @@ def _human(result: dict) -> str:
             f"{name:<{width}} {v['runs']:>5} {_num(v['peak_force_N_p50'], 10, 2)} "
             f"{_num(v['peak_force_N_max'], 10, 2)} {_num(v['exceed_prob'], 10, 3)} "
             f"{ci:>16} {_num(v['contact_loss_s_p50'], 10, 3)} "
-            f"{_num(v['tank_min_J'], 10, 3)} {v.get('watchdog_stops', 0):>8}"
+            f"{_num(v['tank_min_J'], 10, 3)} {v['watchdog_stops']:>8}"
         )
     for c in result.get("paired", []):
         loss, over = c["contact_loss"], c["exceedance"]
@@ -129,6 +129,12 @@ def run_campaign_command(args: argparse.Namespace) -> int:
         name: {key: v[key] for key in CONTROLLER_KEYS}
         for name, v in result["per_controller"].items()
     }
-    # The paired comparison is in summary.json; --json keeps its keys.
-    emit(out, args.json, _human({**out, "paired": result.get("paired", [])}))
+    # The paired comparison and the watchdog's stops are in summary.json and
+    # the table in words; --json keeps its keys.
+    human = {
+        **out,
+        "per_controller": result["per_controller"],
+        "paired": result.get("paired", []),
+    }
+    emit(out, args.json, _human(human))
     return 0 if out["failed"] == 0 else 1

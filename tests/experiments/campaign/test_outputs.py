@@ -188,6 +188,19 @@ def test_the_summary_page_shows_a_dash_for_no_tank(tmp_path):
     assert "<td>NaN</td>" not in page and "nan</td>" not in page
 
 
+def test_the_campaign_command_prints_the_watchdogs_stops(monkeypatch, capsys):
+    """The command's words show the stops that its --json (a contract)
+    leaves to summary.json."""
+    from vic_drake.cli import main
+    from vic_drake.experiments import campaign
+
+    monkeypatch.setattr(campaign, "run_campaign", lambda *a, **k: _result(16))
+    assert main(["campaign", str(SMOKE), "--out", "unused"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    cf = next(line.split() for line in lines if line.startswith("cf "))
+    assert cf[-1] == "1"
+
+
 def test_after_a_resume_the_rate_is_this_sessions_and_says_so():
     # 8 runs in 15 s after 8 done before: 1920 runs/h, and the line says
     # that these are 8 runs, not the 16 finished.
