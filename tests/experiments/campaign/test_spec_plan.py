@@ -24,17 +24,7 @@ def _plans(path):
     return spec, plan_campaign(spec, load_scenario(base))
 
 
-@pytest.mark.parametrize(
-    "name",
-    [
-        "smoke",
-        "breathing",
-        "robustness",
-        "population",
-        "population_online",
-        "robustness_online",
-    ],
-)
+@pytest.mark.parametrize("name", sorted(p.stem for p in CAMPAIGNS.glob("*.yaml")))
 def test_shipped_campaigns_plan_every_run(name):
     spec, plans = _plans(CAMPAIGNS / f"{name}.yaml")
     assert len(plans) == spec.runs
