@@ -230,3 +230,29 @@ def test_paired_needs_a_grid(tmp_path):
     )
     with pytest.raises(VicDrakeError, match="paired needs a grid factor"):
         load_campaign_spec(path)
+
+
+def test_a_true_false_field_is_a_grid_of_two_labels_and_its_own_arm(tmp_path):
+    path = _spec(
+        tmp_path,
+        "paired: true\n"
+        "factors:\n"
+        "  - {field: watchdog.enabled, dist: grid, labels: ['true', 'false']}\n"
+        "  - {field: variations.sensor_faults.stuck_channel, dist: choice,"
+        " values: [2]}\n",
+    )
+    spec, plans = _plans(path)
+    arms = [p.factors["controller"] for p in plans]
+    assert arms == ["vs-vf", "vs-vf no watchdog"] * 4
+    on, off = plans[0].scenario(), plans[1].scenario()
+    assert on.watchdog.enabled and not off.watchdog.enabled
+    assert on.seed == off.seed  # Paired: the same draws.
+
+
+@pytest.mark.parametrize("levels", ["values: [0, 1]", "labels: ['yes', 'no']"])
+def test_a_true_false_field_refuses_other_levels_before_any_run(tmp_path, levels):
+    path = _spec(
+        tmp_path, f"factors:\n  - {{field: watchdog.enabled, dist: grid, {levels}}}\n"
+    )
+    with pytest.raises(VicDrakeError, match=r"'watchdog.enabled' is true/false"):
+        _plans(path)

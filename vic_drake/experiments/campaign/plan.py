@@ -89,10 +89,19 @@ def set_field(scenario: Scenario, path: str, value) -> None:
             obj = getattr(obj, name)
 
 
+#: The labels of a true/false field's factor (strings: quoted in YAML).
+BOOL_LABELS = {"true": True, "false": False}
+
+
 def _coerce(path: str, current, value):
     """The value in the kind of the field it replaces."""
     if isinstance(current, bool):
-        raise VicDrakeError(f"factor {path!r}: true/false fields cannot be varied")
+        if value not in BOOL_LABELS:
+            raise VicDrakeError(
+                f"factor {path!r} is true/false: it takes the labels "
+                f"{list(BOOL_LABELS)} (quoted in YAML); got {value!r}"
+            )
+        return BOOL_LABELS[value]
     if isinstance(current, str):
         if not isinstance(value, str):
             raise VicDrakeError(
@@ -185,10 +194,13 @@ def run_scenario(
 def controller_arm(scenario: Scenario) -> str:
     """The run's arm in a campaign's summary: its controller, with " online"
     where the references come from the online estimates (``stiffness_source``
-    online: the map-free controller), so that a campaign comparing the two
-    sources summarises them apart."""
+    online: the map-free controller) and " no watchdog" where the force
+    sensor's watchdog is off, so that a campaign comparing them summarises
+    them apart."""
     name = scenario.controller.reference.controller
-    return f"{name} online" if scenario.stiffness_source == "online" else name
+    if scenario.stiffness_source == "online":
+        name += " online"
+    return name if scenario.watchdog.enabled else f"{name} no watchdog"
 
 
 def plan_run(spec: CampaignSpec, base: Scenario, index: int) -> RunPlan:
