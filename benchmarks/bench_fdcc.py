@@ -104,7 +104,7 @@ def main(argv=None):
 
     # The watchdog's controller on two contexts whose readings differ, one
     # state between them: each call compares a reading that changed.
-    w_system, w_context, _, w_inputs = _controller(SensorWatchdogParams())
+    w_system, w_context, _, _ = _controller(SensorWatchdogParams())
     w_contexts = (w_context, w_system.CreateDefaultContext())
     u = w_system.get_inputs_input_port().Eval(w_context).copy()
     u[FDCC_IN_FORCE] = [0.001, 0.002, -1.001]  # Every channel differs.

@@ -42,6 +42,7 @@ TRIP_TIME = 7  # When it tripped, s (NaN before).
 TRIP_POSITION = slice(8, 11)  # The probe tip at the trip, W, m (NaN before).
 STUCK_CHANNEL = 11  # The channel that tripped it (0, 1, 2; -1 before).
 WATCHDOG_SIZE = 12
+_RUN0 = LIVE_RUN.start  # The x channel's live run (y, z follow).
 #: Names of the state's elements, in order (for logs and tests).
 WATCHDOG_FIELDS = (
     "last_x",
@@ -138,7 +139,8 @@ def watch_reading(state: np.ndarray, reading, window_ticks: int) -> int:
     f0, f1, f2 = float(reading[0]), float(reading[1]), float(reading[2])
     if not (math.isfinite(f0) and math.isfinite(f1) and math.isfinite(f2)):
         return -1
-    l0, l1, l2 = state[0], state[1], state[2]
+    # Element by element: a slice costs a view per call on this per-tick path.
+    l0, l1, l2 = state[0], state[1], state[2]  # LAST
     state[0], state[1], state[2] = f0, f1, f2
     if math.isnan(l0) or math.isnan(l1) or math.isnan(l2):
         return -1  # The first finite reading: nothing to compare with.
@@ -148,11 +150,11 @@ def watch_reading(state: np.ndarray, reading, window_ticks: int) -> int:
     tripped = -1
     for c in range(3):
         if same[c]:
-            state[3 + c] += 1.0
-            if tripped < 0 and state[3 + c] >= window_ticks:
+            state[_RUN0 + c] += 1.0
+            if tripped < 0 and state[_RUN0 + c] >= window_ticks:
                 tripped = c
         else:
-            state[3 + c] = 0.0
+            state[_RUN0 + c] = 0.0
     return tripped
 
 

@@ -130,7 +130,7 @@ def run_scan(
     fdcc = diagram.GetSubsystemByName("fdcc")
     watch = fdcc.watchdog_state(fdcc.GetMyContextFromRoot(context))
     trip_s, channel = float(watch[TRIP_TIME]), int(watch[STUCK_CHANNEL])
-    df.attrs.update(source="sim", scenario=scenario.name, watchdog_trip_s=trip_s)
+    df.attrs.update(source="sim", scenario=scenario.name)
     rig = rig_frame(logs, context)
     rig.attrs["beta"] = float(phantom.beta)
     return ScanResult(

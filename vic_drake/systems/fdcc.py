@@ -186,8 +186,8 @@ class FdccController(LeafSystem):
         if self._watchdog is not None:
             channel = watch_reading(watch, force, self._window)
             if channel >= 0:
-                t = context.get_time()
-                record_trip(watch, channel, t, self._model.pose(q).translation())
+                tip = self._model.pose(q).translation()
+                record_trip(watch, channel, context.get_time(), tip)
             if watch[TRIPPED] >= 0.5:  # The sensor is not read again.
                 x_d = retract_target(watch, context.get_time(), self._watchdog)
                 stiffness = self._retract_stiffness

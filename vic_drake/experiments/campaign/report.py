@@ -170,7 +170,7 @@ def summary_html(
                     _fmt(v["exceed_prob_ci95"]),
                     _fmt(v["contact_loss_s_p50"]),
                     _fmt(v["tank_min_J"]),
-                    v.get("watchdog_stops", 0),
+                    v["watchdog_stops"],
                 ]
                 for n, v in pc.items()
             ],

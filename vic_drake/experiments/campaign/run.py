@@ -52,7 +52,8 @@ def run_metrics(
     are :func:`vic_drake.analysis.contact.contact_loss_intervals` inside the
     scan window, which ends at ``stop_s`` when that is finite (the time the
     force sensor's watchdog stopped the scan: the retract after it is the
-    stop, not a loss of contact). ``qp_failures`` counts logged samples with ``qp_ok`` = 0.
+    stop, not a loss of contact). ``qp_failures`` counts logged samples
+    with ``qp_ok`` = 0.
     ``tank_min_J`` is NaN for a controller without a tank (``has_tank``
     False: CS, CF).
     """
@@ -87,8 +88,9 @@ def execute_run(plan: RunPlan) -> dict:
         A row: run_id, index, status ("ok" | "nan" | "error"), error (text,
         "" when ok), the sampled factors (``factor.<name>``), the metrics of
         :data:`METRIC_KEYS` (``watchdog_trip_s``: when the force sensor's
-        watchdog stopped the scan, NaN if it did not), sim_s and wall_s; and ``_scenario_yaml``, the
-        run's exact scenario, which the engine stores beside the row.
+        watchdog stopped the scan, NaN if it did not), sim_s and wall_s; and
+        ``_scenario_yaml``, the run's exact scenario, which the engine stores
+        beside the row.
     """
     # Imported here: a worker process pays pydrake's import on its first run.
     from vic_drake.experiments.scan_run import run_scan
