@@ -384,3 +384,20 @@ def test_scan_says_when_the_sensor_watchdog_stopped_it(tmp_path, capsys):
     assert main(["scan", str(path), "--duration", "0.5"]) == 0
     text = capsys.readouterr().out
     assert "sensor watchdog: the z force channel stuck; the scan stopped at" in text
+
+
+def test_scan_says_when_the_sensor_died(tmp_path, capsys):
+    from vic_drake.experiments import synthetic_scenario
+    from vic_drake.scenario import save_scenario
+
+    scenario = synthetic_scenario("cf")
+    faults = scenario.variations.sensor_faults
+    faults.dead, faults.dead_start_s, faults.dropout_mode = True, 0.1, "nan"
+    path = save_scenario(scenario, tmp_path / "dead.yaml")
+    assert main(["scan", str(path), "--duration", "0.5", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["watchdog_channel"] == "all"
+    assert out["campaign_metrics"]["watchdog_trip_s"] == pytest.approx(0.3, abs=0.005)
+    assert main(["scan", str(path), "--duration", "0.5"]) == 0
+    text = capsys.readouterr().out
+    assert "sensor watchdog: the force sensor went dead (no new reading on any" in text

@@ -63,3 +63,17 @@ def test_reading_bias_stuck_and_dropouts():
     assert drop.dropout.all()
     np.testing.assert_allclose(_read(drop, [1, 2, 3], 3), [9, 9, 9])
     assert np.isnan(_read(drop, [1, 2, 3], 3, dropout_mode="nan")).all()
+
+
+def test_a_dead_sensor_is_a_dropout_that_never_ends():
+    quiet = fault_schedule(ticks=10, period_s=0.002, seed=0)
+    # Before it dies the reading is live; from dead_start_s on it is the
+    # last delivered value, or NaN, at every tick (the schedule wraps).
+    np.testing.assert_allclose(_read(quiet, [1, 2, 3], 4, dead_start_s=0.01), [1, 2, 3])
+    for k in (5, 6, 25, 1000):
+        np.testing.assert_allclose(
+            _read(quiet, [1, 2, 3], k, dead_start_s=0.01), [9, 9, 9]
+        )
+        assert np.isnan(
+            _read(quiet, [1, 2, 3], k, dead_start_s=0.01, dropout_mode="nan")
+        ).all()

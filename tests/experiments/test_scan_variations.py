@@ -5,6 +5,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from vic_drake.control.watchdog import DEAD_SENSOR
 from vic_drake.experiments import MakeScanDiagram, run_scan
 from vic_drake.experiments.paper_scenarios import synthetic_scenario
 from vic_drake.experiments.scan_logs import LATERAL_COLUMNS
@@ -125,3 +126,35 @@ def test_breathing_moves_the_phantom_and_a_stuck_sensor_shows_in_the_force():
     assert watched.df["force_tissue_z_N"].max() < 0.1
     z = watched.df["z_m"].to_numpy()
     assert z[-1] > z[0] + 0.02  # Lifted away.
+
+
+@pytest.mark.parametrize("mode", ["hold", "nan"])
+def test_a_sensor_that_dies_in_contact_stops_the_scan(mode):
+    # CF pressing at its target when the sensor dies (its last reading held,
+    # or NaN) and the chest breathes. Without the watchdog the held reading
+    # hides the chest pushing into the probe (the force climbs), and NaN
+    # freezes the arm where it is (every FDCC tick faults). With it (the
+    # default) the probe lifts away 0.2 s after the last reading.
+    s = synthetic_scenario("cf")
+    s.trajectory = _short().trajectory
+    s.variations.motion.breathing.amplitude_m = 0.01
+    s.variations.motion.breathing.frequency_hz = 0.33
+    f = s.variations.sensor_faults
+    f.dead, f.dead_start_s, f.dropout_mode = True, 1.0, mode
+    watched = run_scan(s, duration_s=4.0)
+    assert watched.watchdog_channel == DEAD_SENSOR
+    assert watched.watchdog_trip_s == pytest.approx(1.2, abs=0.005)
+    t = watched.df["t_s"].to_numpy()
+    z = watched.df["z_m"].to_numpy()
+    assert z[-1] > z[t <= 1.0][-1] + 0.02  # Lifted away.
+    assert watched.df["force_tissue_z_N"].to_numpy()[-1] == 0.0
+    s.watchdog.enabled = False
+    unwatched = run_scan(s, duration_s=4.0)
+    assert unwatched.watchdog_channel == -1
+    force = unwatched.df["force_tissue_z_N"].to_numpy()
+    z = unwatched.df["z_m"].to_numpy()
+    if mode == "hold":
+        assert force[t > 1.0].max() > 2.0 * force[t <= 1.0][-1]
+    else:
+        assert abs(z[-1] - z[t <= 1.0][-1]) < 1e-4  # The arm froze in place.
+        assert force[-1] > 1.0

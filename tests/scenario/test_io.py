@@ -44,6 +44,14 @@ def test_the_watchdog_is_on_by_default_and_round_trips():
     assert not scenario.watchdog.enabled
     assert scenario.watchdog.stuck_window_s == 0.1
     assert loads_scenario(dumps_scenario(scenario)) == scenario
+    scenario = loads_scenario(
+        "watchdog: {dead_window_s: 0.1}\n"
+        "variations: {sensor_faults: {dead: true, dead_start_s: 2.5}}\n"
+    )
+    assert scenario.watchdog.dead_window_s == 0.1
+    assert scenario.variations.sensor_faults.dead
+    assert scenario.variations.sensor_faults.active
+    assert loads_scenario(dumps_scenario(scenario)) == scenario
 
 
 def test_simulator_config_round_trips():
@@ -77,6 +85,7 @@ def test_partial_yaml_keeps_defaults_and_validates_nested_values():
         ("simulator: {start_time: 1.0}", r"simulator\.start_time must be 0"),
         ("watchdog: {stuck_window_s: -1}", r"SensorWatchdogParams\.stuck_window_s"),
         ("watchdog: {enable: false}", r"watchdog\.enable is unknown"),
+        ("watchdog: {dead_window_s: 0}", r"SensorWatchdogParams\.dead_window_s"),
     ],
 )
 def test_bad_yaml_names_the_field(text, match):

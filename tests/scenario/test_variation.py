@@ -49,6 +49,8 @@ variations:
         (lambda: PatientMotionConfig(trace_csv="/no/such.csv"), "does not exist"),
         (lambda: SensorFaultConfig(dropout_mode="zero"), "dropout_mode"),
         (lambda: SensorFaultConfig(stuck_channel=3), "stuck_channel"),
+        (lambda: SensorFaultConfig(dead="yes"), r"dead must be true or false"),
+        (lambda: SensorFaultConfig(dead_start_s=-1.0), "dead_start_s"),
         (lambda: SensorFaultConfig(bias_N=[1.0, 2.0]), "bias_N"),
         (lambda: SensorFaultConfig(noise_std_N=-1.0), "noise_std_N"),
         (lambda: MapErrorConfig(kappa_scale=0.0), "kappa_scale"),

@@ -199,6 +199,7 @@ def test_a_stuck_force_channel_trips_the_watchdog_and_the_tick_retracts(q_start)
         TRIP_POSITION,
         TRIP_TIME,
         TRIPPED,
+        WATCHDOG_SIZE,
         SensorWatchdogParams,
     )
 
@@ -209,7 +210,7 @@ def test_a_stuck_force_channel_trips_the_watchdog_and_the_tick_retracts(q_start)
         initial_q=q_start,
         watchdog=watchdog,
     )
-    assert system.GetOutputPort("watchdog").size() == 12
+    assert system.GetOutputPort("watchdog").size() == WATCHDOG_SIZE
     context = system.CreateDefaultContext()
     rng = np.random.default_rng(0)
     window = watchdog.window_ticks(FdccParams().period_s)
@@ -249,6 +250,51 @@ def test_a_stuck_force_channel_trips_the_watchdog_and_the_tick_retracts(q_start)
         expected.q_command,
         atol=1e-15,
     )
+
+
+def test_a_dead_sensor_trips_the_watchdog_and_the_probe_lifts_instead_of_holding(
+    q_start,
+):
+    from vic_drake.control.watchdog import (
+        DEAD_SENSOR,
+        STUCK_CHANNEL,
+        TRIPPED,
+        SensorWatchdogParams,
+    )
+
+    def run(watchdog, ticks):
+        system = FdccController(
+            FdccParams(),
+            station_params=StationParams(),
+            initial_q=q_start,
+            watchdog=watchdog,
+        )
+        context = system.CreateDefaultContext()
+        rng = np.random.default_rng(1)
+        for k in range(ticks):
+            context.SetTime(0.002 * k)
+            force = (
+                0.05 * rng.standard_normal(3) + [0, 0, -5.0] if k < 10 else [np.nan] * 3
+            )
+            _fix_inputs(system, context, q_start, force=force)
+            context.SetDiscreteState(system.EvalUniquePeriodicDiscreteUpdate(context))
+        return system, context
+
+    watchdog = SensorWatchdogParams()
+    dead = watchdog.dead_ticks(FdccParams().period_s)
+    # No reading from tick 10 on: dead at tick 10 + dead - 1.
+    system, context = run(watchdog, 10 + dead - 1)
+    assert system.get_watchdog_output_port().Eval(context)[TRIPPED] == 0.0
+    system, context = run(watchdog, 10 + dead + 50)
+    state = system.get_watchdog_output_port().Eval(context)
+    assert state[TRIPPED] == 1.0 and state[STUCK_CHANNEL] == DEAD_SENSOR
+    # Tripped, the ticks run without the sensor: the tip rises.
+    tip = system.model.pose(system.get_position_command_output_port().Eval(context))
+    assert tip.translation()[2] > system.model.pose(q_start).translation()[2] + 1e-4
+    assert system.get_status_output_port().Eval(context)[0] == 0.0
+    # Without the watchdog every NaN tick faults and holds the command.
+    system, context = run(None, 10 + dead + 50)
+    assert system.get_status_output_port().Eval(context)[1] == dead + 50
 
 
 def test_without_a_watchdog_a_stuck_channel_is_followed(q_start):

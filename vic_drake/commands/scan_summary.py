@@ -65,12 +65,14 @@ def scan_metrics_dict(scenario, result, path: Path, force_limit_N=None) -> dict:
     The first keys are the command's documented output (unchanged);
     ``scan_window_s`` (null without one), ``campaign_metrics`` and
     ``watchdog_channel`` ("x", "y" or "z": the stuck force channel that
-    stopped the scan; null if none did) follow.
+    stopped the scan; "all": the sensor died, every channel frozen; null if
+    the watchdog did not stop it) follow.
     """
     import numpy as np
 
     from vic_drake.analysis import contact, scan_metrics
     from vic_drake.control.references import has_tank
+    from vic_drake.control.watchdog import TRIP_CAUSES
     from vic_drake.experiments.campaign import run_metrics
 
     df = result.df
@@ -113,8 +115,9 @@ def scan_metrics_dict(scenario, result, path: Path, force_limit_N=None) -> dict:
         if window.any()
         else None,
         "campaign_metrics": campaign,
-        # The stuck force channel that stopped the scan (null: none did).
-        "watchdog_channel": "xyz"[result.watchdog_channel]
+        # What stopped the scan: a stuck channel, "all" (a dead sensor), or
+        # null (the watchdog did not).
+        "watchdog_channel": TRIP_CAUSES[result.watchdog_channel]
         if result.watchdog_channel >= 0
         else None,
     }
@@ -165,11 +168,17 @@ def scan_human_summary(out: dict, scenario) -> str:
         )
     else:
         lines.append("contact losses: none")
-    if out.get("watchdog_channel") is not None:
+    cause = out.get("watchdog_channel")
+    if cause is not None:
+        what = (
+            "the force sensor went dead (no new reading on any channel)"
+            if cause == "all"
+            else f"the {cause} force channel stuck"
+        )
         lines.append(
-            f"sensor watchdog: the {out['watchdog_channel']} force channel stuck; "
-            f"the scan stopped at {c['watchdog_trip_s']:.3f} s and the probe "
-            "lifted away (contact losses are counted up to then)"
+            f"sensor watchdog: {what}; the scan stopped at "
+            f"{c['watchdog_trip_s']:.3f} s and the probe lifted away (contact "
+            "losses are counted up to then)"
         )
     tank = (
         f"tank minimum {fmt_number(out['tank_min_J'])} J (floor {c['tank_floor_J']:g} J)"

@@ -9,7 +9,8 @@ A faulty reading of the true sensor force ``u_k`` at control tick k:
 4. a stuck channel: from ``stuck_start_s`` on, one axis keeps the value it
    had then;
 5. dropouts: during random windows (Poisson starts, ``dropout_duration_s``
-   long) the reading is the last delivered value (``hold``) or NaN (``nan``).
+   long) the reading is the last delivered value (``hold``) or NaN (``nan``);
+6. a dead sensor: from ``dead_start_s`` on, a dropout that never ends.
 
 The random parts are drawn once per run from its seed
 (:func:`fault_schedule`), so a run is exactly repeatable on any worker.
@@ -96,8 +97,9 @@ def faulty_reading(
     stuck_value_N: float,
     previous_N: np.ndarray,
     dropout_mode: str,
+    dead_start_s: float = math.inf,
 ) -> np.ndarray:
-    """The reading delivered at one tick (steps 2-5 of the module docstring).
+    """The reading delivered at one tick (steps 2-6 of the module docstring).
 
     Args:
         raw_N: (3,) the (already delayed) true reading.
@@ -109,10 +111,11 @@ def faulty_reading(
         stuck_start_s: when it sticks, s.
         stuck_value_N: the value it sticks at (NaN: this tick's value).
         previous_N: (3,) the reading delivered at the previous tick.
-        dropout_mode: "hold" or "nan".
+        dropout_mode: "hold" or "nan" (dropouts and a dead sensor).
+        dead_start_s: when the sensor dies, s (inf: never).
     """
     k = tick % schedule.ticks
-    if schedule.dropout[k]:
+    if schedule.dropout[k] or t_s >= dead_start_s:
         if dropout_mode == "nan":
             return np.full(3, np.nan)
         return np.array(previous_N, float)

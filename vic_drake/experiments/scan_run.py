@@ -50,8 +50,9 @@ class ScanResult:
             :func:`vic_drake.experiments.rig_log.rig_log_rows`.
         watchdog_trip_s: when the force sensor's watchdog tripped and the
             probe began to lift away, s (NaN: it did not, or it is off).
-        watchdog_channel: the stuck force channel that tripped it (0, 1, 2
-            for x, y, z; -1 if none).
+        watchdog_channel: what tripped it: the stuck force channel (0, 1,
+            2 for x, y, z), :data:`~vic_drake.control.watchdog.DEAD_SENSOR`
+            (3: the whole reading froze), or -1 if nothing did.
     """
 
     df: pd.DataFrame

@@ -8,6 +8,8 @@ variations builds the same diagram as before).
 
 from __future__ import annotations
 
+import math
+
 from vic_drake.scenario import Scenario
 from vic_drake.systems.patient_motion import PatientMotionSource
 from vic_drake.systems.sensor_faults import FaultySensor
@@ -89,6 +91,7 @@ def add_sensor_faults(builder, scenario: Scenario, force_port):
             extra_latency_s=f.extra_latency_s,
             stuck_channel=f.stuck_channel,
             stuck_start_s=f.stuck_start_s,
+            dead_start_s=f.dead_start_s if f.dead else math.inf,
         ),
     )
     builder.Connect(force_port, sensor.get_input_port_force())

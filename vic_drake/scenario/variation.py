@@ -187,6 +187,9 @@ class SensorFaultConfig:
     extra_latency_s: float = 0.0  # Added delay, s (rounded to control ticks).
     stuck_channel: int = -1  # -1: none; 0, 1, 2: the axis x, y, z that sticks.
     stuck_start_s: float = 0.0  # When it sticks, s.
+    # The sensor dies at dead_start_s: a dropout (dropout_mode) that never ends.
+    dead: bool = False
+    dead_start_s: float = 0.0  # When it dies, s.
     seed: int = 0  # Seed of the noise, spikes and dropouts.
 
     def __post_init__(self):
@@ -225,6 +228,9 @@ class SensorFaultConfig:
                 f"{o}.stuck_channel must be -1 (none), 0, 1 or 2; got {self.stuck_channel!r}"
             )
         check_number(o, "stuck_start_s", self.stuck_start_s, low=0.0)
+        if not isinstance(self.dead, bool):
+            raise VicDrakeError(f"{o}.dead must be true or false; got {self.dead!r}")
+        check_number(o, "dead_start_s", self.dead_start_s, low=0.0)
         _check_int(o, "seed", self.seed, 0)
         return self
 
@@ -237,6 +243,7 @@ class SensorFaultConfig:
             or (self.spike_rate_per_s > 0 and self.spike_magnitude_N > 0)
             or self.extra_latency_s > 0
             or self.stuck_channel >= 0
+            or self.dead
         )
 
 

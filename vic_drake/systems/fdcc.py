@@ -59,15 +59,16 @@ class FdccController(LeafSystem):
         status (2): (fault on the last tick, number of faulted ticks). A
             fault -- a non-finite input or result, or a negative stiffness --
             holds the previous command and zeroes the internal velocity.
-        watchdog (12, ``control.watchdog.WATCHDOG_FIELDS``): the force
+        watchdog (13, ``control.watchdog.WATCHDOG_FIELDS``): the force
             sensor's watchdog (all zeros but the NaN fields when disabled).
 
     State (discrete, updated every ``period_s``): the command q (6), the
     internal velocity (6) and the PD's last error (6), the status (2) and
-    the watchdog (12).
+    the watchdog (13).
 
     With a watchdog (``watchdog.enabled``), a force channel that keeps its
-    value while the others change trips it (:mod:`vic_drake.control.watchdog`);
+    value while the others change, or a reading that stops changing
+    altogether, trips it (:mod:`vic_drake.control.watchdog`);
     from then on the tick ignores the sensor, the stiffness and the targets
     of its inputs and lifts the probe away from the tissue
     (:func:`~vic_drake.control.watchdog.retract_target`).
@@ -116,6 +117,7 @@ class FdccController(LeafSystem):
         )
         if self._watchdog is not None:
             self._window = self._watchdog.window_ticks(self._params.period_s)
+            self._dead_window = self._watchdog.dead_ticks(self._params.period_s)
             k = self._watchdog.retract_stiffness_N_per_m
             self._retract_stiffness = np.array([k, k, k])
         self._inputs_port = self.DeclareVectorInputPort("inputs", FDCC_INPUTS_SIZE)
@@ -184,7 +186,7 @@ class FdccController(LeafSystem):
         force = u[FDCC_IN_FORCE]
         target_force = u[FDCC_IN_TARGET_FORCE]
         if self._watchdog is not None:
-            channel = watch_reading(watch, force, self._window)
+            channel = watch_reading(watch, force, self._window, self._dead_window)
             if channel >= 0:
                 tip = self._model.pose(q).translation()
                 record_trip(watch, channel, context.get_time(), tip)

@@ -21,7 +21,8 @@ from vic_drake.errors import VicDrakeError
 
 
 class FaultySensor(LeafSystem):
-    """The force reading with bias, noise, spikes, latency, a stuck axis, dropouts.
+    """The force reading with bias, noise, spikes, latency, a stuck axis,
+    dropouts and a sensor that dies.
 
     Input ports:
         force_W: (3,) true sensor force in W, N.
@@ -50,6 +51,7 @@ class FaultySensor(LeafSystem):
         extra_latency_s: float = 0.0,
         stuck_channel: int = -1,
         stuck_start_s: float = 0.0,
+        dead_start_s: float = math.inf,
     ):
         super().__init__()
         if dropout_mode not in DROPOUT_MODES:
@@ -76,6 +78,7 @@ class FaultySensor(LeafSystem):
         self._latency = int(round(extra_latency_s / self._period_s))
         self._stuck_channel = int(stuck_channel)
         self._stuck_start_s = float(stuck_start_s)
+        self._dead_start_s = float(dead_start_s)
         self._mode = dropout_mode
         self._input = self.DeclareVectorInputPort("force_W", 3)
         self._state = self.DeclareDiscreteState(
@@ -116,6 +119,7 @@ class FaultySensor(LeafSystem):
             stuck_value_N=float(x[3]),
             previous_N=x[0:3],
             dropout_mode=self._mode,
+            dead_start_s=self._dead_start_s,
         )
         return y, u, x
 
