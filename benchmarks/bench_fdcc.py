@@ -120,7 +120,7 @@ def main(argv=None):
 
     def watch():
         state["k"] ^= 1
-        watch_reading(watch_state, readings[state["k"]], 25)
+        watch_reading(watch_state, readings[state["k"]], 25, 100)
 
     def eval_update():
         context.SetTime(context.get_time() + 1e-9)
