@@ -397,7 +397,7 @@ def test_scan_says_when_the_sensor_died(tmp_path, capsys):
     assert main(["scan", str(path), "--duration", "0.5", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["watchdog_channel"] == "all"
-    assert out["campaign_metrics"]["watchdog_trip_s"] == pytest.approx(0.3, abs=0.005)
+    assert out["campaign_metrics"]["watchdog_trip_s"] == pytest.approx(0.2, abs=0.005)
     assert main(["scan", str(path), "--duration", "0.5"]) == 0
     text = capsys.readouterr().out
     assert "sensor watchdog: the force sensor went dead (no new reading on any" in text

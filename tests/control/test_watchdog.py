@@ -141,7 +141,7 @@ def test_window_in_ticks():
     assert SensorWatchdogParams(stuck_window_s=0.05).window_ticks(0.002) == 25
     assert SensorWatchdogParams(stuck_window_s=0.051).window_ticks(0.002) == 26
     assert SensorWatchdogParams(stuck_window_s=1e-4).window_ticks(0.002) == 2
-    assert SensorWatchdogParams().dead_ticks(0.002) == 100
+    assert SensorWatchdogParams().dead_ticks(0.002) == 50
 
 
 @pytest.mark.parametrize(

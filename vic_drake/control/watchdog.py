@@ -23,9 +23,10 @@ pulled out): the force loop is then blind on every axis at once.
   count nor reset this run; a non-finite reading is skipped;
 - the ticks since the reading last changed (a whole reading repeated, or
   not finite). ``dead_window_s`` of them trip the watchdog as a dead
-  sensor (:data:`DEAD_SENSOR`). The window is longer than the stuck one:
-  a held dropout is a short dead spell (the fault campaigns' merged
-  dropouts last up to 0.14 s), which the controller rides through.
+  sensor (:data:`DEAD_SENSOR`): 0.1 s, 50 samples, ten times the rig's
+  longest repeat. The controller rides through a shorter blackout, such as
+  one of the fault campaigns' 0.05 s dropouts; two of them back to back
+  are a dead sensor.
 
 Once tripped the watchdog latches, and the compliance stage stops using the
 sensor: :func:`retract_target` moves the target up from the probe's position
@@ -86,9 +87,9 @@ class SensorWatchdogParams:
     # (the rig's longest run of repeated samples spans 0.010 s).
     stuck_window_s: float = 0.05
     # Time without a new reading (every channel repeated, or not finite)
-    # after which the sensor counts as dead, s (the fault campaigns' held
-    # dropouts last up to 0.14 s when they chain).
-    dead_window_s: float = 0.2
+    # after which the sensor counts as dead, s (the rig's longest repeat of
+    # a whole reading spans 0.010 s).
+    dead_window_s: float = 0.1
     # Speed of the retract, m/s (above the 0.015 m/s a 15 mm breath at
     # 0.33 Hz lifts the chest at).
     retract_speed_m_per_s: float = 0.03
