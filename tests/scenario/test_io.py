@@ -86,6 +86,11 @@ def test_partial_yaml_keeps_defaults_and_validates_nested_values():
         ("watchdog: {stuck_window_s: -1}", r"SensorWatchdogParams\.stuck_window_s"),
         ("watchdog: {enable: false}", r"watchdog\.enable is unknown"),
         ("watchdog: {dead_window_s: 0}", r"SensorWatchdogParams\.dead_window_s"),
+        (
+            "station: {sensor_period_s: 0.08}",
+            r"watchdog\.dead_window_s \(0\.1 s\) must be at least twice "
+            r"station\.sensor_period_s \(0\.08 s\)",
+        ),
     ],
 )
 def test_bad_yaml_names_the_field(text, match):

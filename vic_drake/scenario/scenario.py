@@ -244,6 +244,14 @@ class Scenario:
             raise VicDrakeError(f"{o}.seed must be an integer >= 0; got {self.seed!r}")
         if self.duration_s is not None:
             check_number(o, "duration_s", self.duration_s, low=0.0, low_open=True)
+        period = self.station.sensor_period_s
+        if self.watchdog.enabled and self.watchdog.dead_window_s < 2 * period:
+            raise VicDrakeError(
+                f"{o}.watchdog.dead_window_s ({self.watchdog.dead_window_s:g} s) "
+                f"must be at least twice station.sensor_period_s ({period:g} s): "
+                "a live sensor at that rate repeats each reading for a period; "
+                "raise dead_window_s (or set watchdog.enabled: false)"
+            )
         if self.variations.patient.enabled and self.phantom.kind != "synthetic":
             raise VicDrakeError(
                 f"{o}.variations.patient needs phantom.kind 'synthetic' (a "
