@@ -137,6 +137,28 @@ def test_contact_losses_count_up_to_the_watchdogs_stop():
     ] == pytest.approx(0.2, abs=0.005)
 
 
+def test_the_controllers_figures_after_the_watchdogs_stop_do_not_count():
+    # After the stop the QP and the tank run on the stale sensor (e.g. a
+    # stuck pressing reading while the probe lifts: the QP fails), but the
+    # arm follows the retract, not them.
+    t = np.arange(0, 4, 0.002)
+    after = t >= 2.0
+    df = pd.DataFrame(
+        {
+            "t_s": t,
+            "z_d_m": 0.085,
+            "force_sensor_z_N": -7.0,
+            "force_tissue_z_N": np.where(after, 0.0, -7.0),
+            "tank_energy_J": np.where(after, 0.3, 0.5),
+            "qp_ok": np.where(after, 0.0, 1.0),
+        }
+    )
+    whole = run_metrics(df, force_limit_N=15.0)
+    assert whole["qp_failures"] == 1000 and whole["tank_min_J"] == 0.3
+    stopped = run_metrics(df, force_limit_N=15.0, stop_s=2.0)
+    assert stopped["qp_failures"] == 0 and stopped["tank_min_J"] == 0.5
+
+
 def _rows() -> pd.DataFrame:
     return pd.DataFrame(
         {

@@ -53,7 +53,9 @@ def run_metrics(
     scan window, which ends at ``stop_s`` when that is finite (the time the
     force sensor's watchdog stopped the scan: the retract after it is the
     stop, not a loss of contact). ``qp_failures`` counts logged samples
-    with ``qp_ok`` = 0.
+    with ``qp_ok`` = 0 and ``tank_min_J`` is the tank's lowest energy, both
+    before ``stop_s``: after the stop the controller's QP and tank still
+    run on the stale sensor, but the arm no longer follows them.
     ``tank_min_J`` is NaN for a controller without a tank (``has_tank``
     False: CS, CF).
     """
@@ -61,8 +63,8 @@ def run_metrics(
     f = df["force_tissue_z_N"].to_numpy(float)
     dt = np.diff(t, append=t[-1] + (t[-1] - t[-2] if t.size > 1 else 0.0))
     window = scan_window(df)
-    if math.isfinite(stop_s):
-        window &= t < stop_s
+    driven = t < stop_s if math.isfinite(stop_s) else np.ones(t.size, bool)
+    window &= driven
     losses = contact_loss_intervals(df, window=window)
     qp_ok = df["qp_ok"].to_numpy(float)
     return {
@@ -70,8 +72,8 @@ def run_metrics(
         "p99_force_N": float(np.nanpercentile(f, 99)),
         "time_above_limit_s": float(dt[f > force_limit_N].sum()),
         "contact_loss_s": float(sum(b - a for a, b in losses)),
-        "tank_min_J": tank_min_J(df, has_tank=has_tank),
-        "qp_failures": int(np.sum(qp_ok < 0.5)),
+        "tank_min_J": tank_min_J(df[driven], has_tank=has_tank),
+        "qp_failures": int(np.sum((qp_ok < 0.5) & driven)),
     }
 
 
