@@ -252,6 +252,23 @@ def test_a_stuck_force_channel_trips_the_watchdog_and_the_tick_retracts(q_start)
     )
 
 
+def _run_fdcc(q_start, watchdog, forces):
+    """An FdccController fed ``forces`` one tick each (the other inputs
+    fixed at ``q_start``); returns it and its context after the last tick."""
+    system = FdccController(
+        FdccParams(),
+        station_params=StationParams(),
+        initial_q=q_start,
+        watchdog=watchdog,
+    )
+    context = system.CreateDefaultContext()
+    for k, force in enumerate(forces):
+        context.SetTime(0.002 * k)
+        _fix_inputs(system, context, q_start, force=force)
+        context.SetDiscreteState(system.EvalUniquePeriodicDiscreteUpdate(context))
+    return system, context
+
+
 def test_a_dead_sensor_trips_the_watchdog_and_the_probe_lifts_instead_of_holding(
     q_start,
 ):
@@ -263,22 +280,12 @@ def test_a_dead_sensor_trips_the_watchdog_and_the_probe_lifts_instead_of_holding
     )
 
     def run(watchdog, ticks):
-        system = FdccController(
-            FdccParams(),
-            station_params=StationParams(),
-            initial_q=q_start,
-            watchdog=watchdog,
-        )
-        context = system.CreateDefaultContext()
         rng = np.random.default_rng(1)
-        for k in range(ticks):
-            context.SetTime(0.002 * k)
-            force = (
-                0.05 * rng.standard_normal(3) + [0, 0, -5.0] if k < 10 else [np.nan] * 3
-            )
-            _fix_inputs(system, context, q_start, force=force)
-            context.SetDiscreteState(system.EvalUniquePeriodicDiscreteUpdate(context))
-        return system, context
+        forces = [
+            0.05 * rng.standard_normal(3) + [0, 0, -5.0] if k < 10 else [np.nan] * 3
+            for k in range(ticks)
+        ]
+        return _run_fdcc(q_start, watchdog, forces)
 
     watchdog = SensorWatchdogParams()
     dead = watchdog.dead_ticks(FdccParams().period_s)
@@ -301,17 +308,10 @@ def test_without_a_watchdog_a_stuck_channel_is_followed(q_start):
     from vic_drake.control.watchdog import SensorWatchdogParams
 
     for watchdog in (None, SensorWatchdogParams(enabled=False)):
-        system = FdccController(
-            FdccParams(),
-            station_params=StationParams(),
-            initial_q=q_start,
-            watchdog=watchdog,
-        )
-        context = system.CreateDefaultContext()
         rng = np.random.default_rng(0)
-        for k in range(60):
-            context.SetTime(0.002 * k)
-            force = (0.05 * rng.standard_normal(), 0.05 * rng.standard_normal(), -1.0)
-            _fix_inputs(system, context, q_start, force=force)
-            context.SetDiscreteState(system.EvalUniquePeriodicDiscreteUpdate(context))
+        forces = [
+            (0.05 * rng.standard_normal(), 0.05 * rng.standard_normal(), -1.0)
+            for _ in range(60)
+        ]
+        system, context = _run_fdcc(q_start, watchdog, forces)
         assert system.get_watchdog_output_port().Eval(context)[6] == 0.0
