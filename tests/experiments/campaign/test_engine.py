@@ -60,6 +60,7 @@ def test_smoke_campaign_passes_with_no_failed_or_nan_run(smoke_local):
     rows = read_rows(smoke_local)
     assert sorted(rows["run_id"]) == _planned_ids(SMOKE)
     assert (rows["status"] == "ok").all()
+    assert (rows["watchdog_cause"] == "").all()  # No fault stopped a run.
     assert rows["peak_force_N"].between(1.0, 40.0).all()  # Every probe pressed.
     vs = rows[rows["factor.controller"].str.startswith("vs")]
     assert (vs["tank_min_J"] >= vs["tank_floor_J"] - 1e-9).all()
@@ -307,3 +308,18 @@ def test_ctrl_c_while_the_cluster_starts_leaves_nothing(tmp_path):
     assert err == "vic-drake: interrupted\n", err
     assert not out.exists()
     _wait_until_the_group_is_gone(proc.pid)
+
+
+def test_a_run_row_says_what_stopped_it():
+    from vic_drake.experiments.campaign.run import execute_run
+
+    spec, base = load_campaign_spec(CAMPAIGNS / "robustness_dead.yaml")
+    dies_at = "variations.sensor_faults.dead_start_s"
+    # The first run whose sensor dies well before its end.
+    plan = next(
+        p for p in plan_campaign(spec, load_scenario(base)) if p.factors[dies_at] < 3.5
+    )
+    row = execute_run(plan)
+    dies = plan.factors[dies_at]
+    assert row["status"] == "ok" and row["watchdog_cause"] == "all"
+    assert row["watchdog_trip_s"] <= dies + 0.1 + 1e-9

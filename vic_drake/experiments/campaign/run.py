@@ -19,6 +19,7 @@ import pandas as pd
 from vic_drake.analysis.contact import contact_loss_intervals, scan_window
 from vic_drake.analysis.scan_metrics import tank_min_J
 from vic_drake.control.references import has_tank
+from vic_drake.control.watchdog import TRIP_CAUSES
 from vic_drake.experiments.campaign.plan import RunPlan
 from vic_drake.scenario import dumps_scenario
 
@@ -90,7 +91,9 @@ def execute_run(plan: RunPlan) -> dict:
         A row: run_id, index, status ("ok" | "nan" | "error"), error (text,
         "" when ok), the sampled factors (``factor.<name>``), the metrics of
         :data:`METRIC_KEYS` (``watchdog_trip_s``: when the force sensor's
-        watchdog stopped the scan, NaN if it did not), sim_s and wall_s; and
+        watchdog stopped the scan, NaN if it did not), ``watchdog_cause``
+        (what stopped it: "x", "y" or "z" for a stuck channel, "all" for a
+        dead sensor, "" if nothing did), sim_s and wall_s; and
         ``_scenario_yaml``, the run's exact scenario, which the engine stores
         beside the row.
     """
@@ -101,6 +104,7 @@ def execute_run(plan: RunPlan) -> dict:
     row = {"run_id": plan.run_id, "index": plan.index, "status": "ok", "error": ""}
     row.update({f"factor.{k}": v for k, v in plan.factors.items()})
     row.update({k: math.nan for k in METRIC_KEYS})
+    row["watchdog_cause"] = ""
     row["sim_s"] = plan.duration_s
     try:
         scenario = plan.scenario()
@@ -122,6 +126,8 @@ def execute_run(plan: RunPlan) -> dict:
                 )
             )
         row["watchdog_trip_s"] = result.watchdog_trip_s
+        if result.watchdog_channel >= 0:
+            row["watchdog_cause"] = TRIP_CAUSES[result.watchdog_channel]
         if bad:
             row["status"] = "nan"
             first = float(
@@ -163,7 +169,7 @@ def failed_row(plan: RunPlan, error: str, *, wall_s: float = math.nan) -> dict:
     }
     row.update({f"factor.{k}": v for k, v in plan.factors.items()})
     row.update({k: math.nan for k in METRIC_KEYS})
-    row.update(sim_s=plan.duration_s, wall_s=wall_s)
+    row.update(watchdog_cause="", sim_s=plan.duration_s, wall_s=wall_s)
     return row
 
 
