@@ -96,11 +96,13 @@ def main(argv=None):
     plant, scratch = model.plant, model._context
     world, origin = plant.world_frame(), np.zeros(3)
     q_alt = (q_m, q_m + 1e-6)
-    state = {"k": 0}
+    # One alternation per kind: a counter shared by several kinds would
+    # flip an even number of times between two calls of one of them.
+    state = {"positions": 0, "update": 0, "watch": 0}
 
     def set_positions():
-        state["k"] ^= 1
-        plant.SetPositions(scratch, q_alt[state["k"]])
+        state["positions"] ^= 1
+        plant.SetPositions(scratch, q_alt[state["positions"]])
 
     # The watchdog's controller on two contexts whose readings differ, one
     # state between them: each call compares a reading that changed.
@@ -113,14 +115,17 @@ def main(argv=None):
     w_state.SetFrom(w_context.get_discrete_state())
     readings = (np.array([0.01, 0.02, -1.0]), np.array([0.02, 0.01, -1.001]))
     watch_state = initial_watchdog_state()
+    defaults = SensorWatchdogParams()
+    window = defaults.window_ticks(FdccParams().period_s)
+    dead = defaults.dead_ticks(FdccParams().period_s)
 
     def watched_update():
-        state["k"] ^= 1
-        w_system._update(w_contexts[state["k"]], w_state)
+        state["update"] ^= 1
+        w_system._update(w_contexts[state["update"]], w_state)
 
     def watch():
-        state["k"] ^= 1
-        watch_reading(watch_state, readings[state["k"]], 25, 100)
+        state["watch"] ^= 1
+        watch_reading(watch_state, readings[state["watch"]], window, dead)
 
     def eval_update():
         context.SetTime(context.get_time() + 1e-9)

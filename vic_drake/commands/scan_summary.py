@@ -72,7 +72,6 @@ def scan_metrics_dict(scenario, result, path: Path, force_limit_N=None) -> dict:
 
     from vic_drake.analysis import contact, scan_metrics
     from vic_drake.control.references import has_tank
-    from vic_drake.control.watchdog import TRIP_CAUSES
     from vic_drake.experiments.campaign import run_metrics
 
     df = result.df
@@ -117,9 +116,7 @@ def scan_metrics_dict(scenario, result, path: Path, force_limit_N=None) -> dict:
         "campaign_metrics": campaign,
         # What stopped the scan: a stuck channel, "all" (a dead sensor), or
         # null (the watchdog did not).
-        "watchdog_channel": TRIP_CAUSES[result.watchdog_channel]
-        if result.watchdog_channel >= 0
-        else None,
+        "watchdog_channel": result.watchdog_cause or None,
     }
 
 

@@ -16,7 +16,7 @@ import pandas as pd
 from pydrake.common import RandomGenerator
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
 
-from vic_drake.control.watchdog import STUCK_CHANNEL, TRIP_TIME
+from vic_drake.control.watchdog import STUCK_CHANNEL, TRIP_CAUSES, TRIP_TIME
 from vic_drake.errors import VicDrakeError
 from vic_drake.experiments.rig_log import rig_frame
 from vic_drake.experiments.scan_diagram import (
@@ -65,6 +65,12 @@ class ScanResult:
     rig: pd.DataFrame | None = None
     watchdog_trip_s: float = math.nan
     watchdog_channel: int = -1
+
+    @property
+    def watchdog_cause(self) -> str:
+        """What stopped the scan: "x", "y" or "z" (a stuck channel), "all"
+        (a dead sensor), or "" (the watchdog did not)."""
+        return TRIP_CAUSES[self.watchdog_channel] if self.watchdog_channel >= 0 else ""
 
 
 def run_scan(

@@ -19,7 +19,6 @@ import pandas as pd
 from vic_drake.analysis.contact import contact_loss_intervals, scan_window
 from vic_drake.analysis.scan_metrics import tank_min_J
 from vic_drake.control.references import has_tank
-from vic_drake.control.watchdog import TRIP_CAUSES
 from vic_drake.experiments.campaign.plan import RunPlan
 from vic_drake.scenario import dumps_scenario
 
@@ -126,8 +125,7 @@ def execute_run(plan: RunPlan) -> dict:
                 )
             )
         row["watchdog_trip_s"] = result.watchdog_trip_s
-        if result.watchdog_channel >= 0:
-            row["watchdog_cause"] = TRIP_CAUSES[result.watchdog_channel]
+        row["watchdog_cause"] = result.watchdog_cause
         if bad:
             row["status"] = "nan"
             first = float(
