@@ -13,7 +13,7 @@ BENCHMARKS = Path(__file__).resolve().parents[1] / "benchmarks"
 @pytest.mark.parametrize(
     "script, args, prints",
     [
-        ("bench_fdcc.py", ["--calls", "5"], "per call, us"),
+        ("bench_fdcc.py", ["--calls", "60"], "per call, us"),
         ("bench_station.py", ["--duration", "0.05"], "RTF"),
     ],
 )
