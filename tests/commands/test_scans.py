@@ -397,7 +397,12 @@ def test_scan_says_when_the_sensor_died(tmp_path, capsys):
     assert main(["scan", str(path), "--duration", "0.5", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["watchdog_channel"] == "all"
-    assert out["campaign_metrics"]["watchdog_trip_s"] == pytest.approx(0.2, abs=0.005)
+    metrics = out["campaign_metrics"]
+    assert metrics["watchdog_trip_s"] == pytest.approx(0.2, abs=0.005)
+    # The NaN ticks before the stop are skipped solves, not failed ones.
+    assert metrics["qp_failures"] == 0 and 45 <= metrics["input_faults"] <= 50
     assert main(["scan", str(path), "--duration", "0.5"]) == 0
     text = capsys.readouterr().out
     assert "sensor watchdog: the force sensor went dead (no new reading on any" in text
+    assert "; 0 failed QP solves; " in text
+    assert f"; {metrics['input_faults']} ticks skipped the QP on a non-finite" in text

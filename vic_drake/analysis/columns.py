@@ -16,7 +16,10 @@ import pandas as pd
 from vic_drake.errors import VicDrakeError
 from vic_drake.paper import CONTACT_THRESHOLD_N
 
-#: The columns of a scan DataFrame (interfaces.md, "D2").
+#: The columns of a scan DataFrame. ``qp_ok`` is 0 on a tick whose stiffness
+#: QP failed or was skipped; ``qp_fault`` is 1 on a tick the controller
+#: skipped because an input (the sensor's reading, mostly) was not finite:
+#: a failed solve is ``qp_ok`` 0 with ``qp_fault`` 0.
 CANONICAL_COLUMNS = (
     "t_s",
     "x_m",
@@ -42,6 +45,7 @@ CANONICAL_COLUMNS = (
     "tank_sigma",
     "tank_enabled",
     "qp_ok",
+    "qp_fault",
     "in_contact",
     *(f"q_cmd_{i}_rad" for i in range(6)),
 )

@@ -182,9 +182,15 @@ def scan_human_summary(out: dict, scenario) -> str:
         if math.isfinite(c["tank_floor_J"])
         else "no energy tank (" + out["controller"] + ")"
     )
+    skipped = (
+        f"; {c['input_faults']} ticks skipped the QP on a non-finite sensor "
+        "reading (stiffness held at K_min)"
+        if c["input_faults"]
+        else ""
+    )
     lines.append(
-        f"{tank}; {c['qp_failures']} failed QP solves; lifted off at the end: "
-        f"{'yes' if out['lifted_off'] else 'no'}"
+        f"{tank}; {c['qp_failures']} failed QP solves{skipped}; lifted off at the "
+        f"end: {'yes' if out['lifted_off'] else 'no'}"
     )
     for key, what in (("log", "log"), ("bag", "bag")):
         if key in out:

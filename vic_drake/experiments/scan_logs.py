@@ -140,7 +140,7 @@ LOG_GROUPS = (
         "variable_impedance_controller",
         "status",
         STATUS_FIELDS,
-        {"qp_ok": "qp_ok", "in_contact": "in_contact"},
+        {"qp_ok": "qp_ok", "fault": "qp_fault", "in_contact": "in_contact"},
     ),
     LogGroup(
         "q_cmd",

@@ -61,6 +61,7 @@ def test_smoke_campaign_passes_with_no_failed_or_nan_run(smoke_local):
     assert sorted(rows["run_id"]) == _planned_ids(SMOKE)
     assert (rows["status"] == "ok").all()
     assert (rows["watchdog_cause"] == "").all()  # No fault stopped a run.
+    assert (rows["qp_failures"] == 0).all() and (rows["input_faults"] == 0).all()
     assert rows["peak_force_N"].between(1.0, 40.0).all()  # Every probe pressed.
     vs = rows[rows["factor.controller"].str.startswith("vs")]
     assert (vs["tank_min_J"] >= vs["tank_floor_J"] - 1e-9).all()
@@ -315,11 +316,19 @@ def test_a_run_row_says_what_stopped_it():
 
     spec, base = load_campaign_spec(CAMPAIGNS / "robustness_dead.yaml")
     dies_at = "variations.sensor_faults.dead_start_s"
-    # The first run whose sensor dies well before its end.
+    mode = "variations.sensor_faults.dropout_mode"
+    # The first run whose sensor dies well before its end, into NaN.
     plan = next(
-        p for p in plan_campaign(spec, load_scenario(base)) if p.factors[dies_at] < 3.5
+        p
+        for p in plan_campaign(spec, load_scenario(base))
+        if p.factors[dies_at] < 3.5 and p.factors[mode] == "nan"
     )
     row = execute_run(plan)
     dies = plan.factors[dies_at]
     assert row["status"] == "ok" and row["watchdog_cause"] == "all"
     assert row["watchdog_trip_s"] <= dies + 0.1 + 1e-9
+    # The NaN ticks before the stop skip the QP: input faults, not failed
+    # solves (the run's short NaN dropouts before its death add to them).
+    period = load_scenario(base).logging.period_s  # One logged sample a tick.
+    assert row["qp_failures"] == 0
+    assert row["input_faults"] >= (row["watchdog_trip_s"] - dies) / period - 2

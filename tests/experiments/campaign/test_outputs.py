@@ -108,6 +108,7 @@ def test_tankless_controllers_have_nan_tank_metrics():
             "force_tissue_z_N": -7.0,
             "tank_energy_J": 0.5,  # What CS and CF log: the initial energy.
             "qp_ok": 1.0,
+            "qp_fault": 0.0,
         }
     )
     assert math.isnan(run_metrics(df, force_limit_N=15.0, has_tank=False)["tank_min_J"])
@@ -125,6 +126,7 @@ def test_contact_losses_count_up_to_the_watchdogs_stop():
             "force_tissue_z_N": np.where(lost, 0.0, -7.0),
             "tank_energy_J": 0.5,
             "qp_ok": 1.0,
+            "qp_fault": 0.0,
         }
     )
     everything = run_metrics(df, force_limit_N=15.0)["contact_loss_s"]
@@ -151,12 +153,36 @@ def test_the_controllers_figures_after_the_watchdogs_stop_do_not_count():
             "force_tissue_z_N": np.where(after, 0.0, -7.0),
             "tank_energy_J": np.where(after, 0.3, 0.5),
             "qp_ok": np.where(after, 0.0, 1.0),
+            "qp_fault": 0.0,
         }
     )
     whole = run_metrics(df, force_limit_N=15.0)
     assert whole["qp_failures"] == 1000 and whole["tank_min_J"] == 0.3
     stopped = run_metrics(df, force_limit_N=15.0, stop_s=2.0)
     assert stopped["qp_failures"] == 0 and stopped["tank_min_J"] == 0.5
+
+
+def test_ticks_skipped_on_a_non_finite_input_are_not_failed_solves():
+    t = np.arange(0, 4, 0.002)
+    nan_reading = (t >= 1.0) & (t < 1.1)  # The QP is skipped: K = K_min.
+    failed = (t >= 2.0) & (t < 2.01)  # The solver fails.
+    df = pd.DataFrame(
+        {
+            "t_s": t,
+            "z_d_m": 0.085,
+            "force_sensor_z_N": -7.0,
+            "force_tissue_z_N": -7.0,
+            "tank_energy_J": 0.5,
+            "qp_ok": np.where(nan_reading | failed, 0.0, 1.0),
+            "qp_fault": np.where(nan_reading, 1.0, 0.0),
+        }
+    )
+    metrics = run_metrics(df, force_limit_N=15.0)
+    assert metrics["qp_failures"] == 5 and metrics["input_faults"] == 50
+    stopped = run_metrics(df, force_limit_N=15.0, stop_s=1.05)
+    assert stopped["qp_failures"] == 0 and stopped["input_faults"] == 25
+    with pytest.raises(VicDrakeError, match="qp_fault"):
+        run_metrics(df.drop(columns="qp_fault"), force_limit_N=15.0)
 
 
 def _rows() -> pd.DataFrame:

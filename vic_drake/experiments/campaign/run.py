@@ -16,6 +16,7 @@ import traceback
 import numpy as np
 import pandas as pd
 
+from vic_drake.analysis.columns import require_columns
 from vic_drake.analysis.contact import contact_loss_intervals, scan_window
 from vic_drake.analysis.scan_metrics import tank_min_J
 from vic_drake.control.references import has_tank
@@ -34,6 +35,7 @@ METRIC_KEYS = (
     "tank_min_J",
     "tank_floor_J",
     "qp_failures",
+    "input_faults",
     "watchdog_trip_s",
 )
 
@@ -53,9 +55,12 @@ def run_metrics(
     scan window, which ends at ``stop_s`` when that is finite (the time the
     force sensor's watchdog stopped the scan: the retract after it is the
     stop, not a loss of contact). ``qp_failures`` counts logged samples
-    with ``qp_ok`` = 0 and ``tank_min_J`` is the tank's lowest energy, both
-    before ``stop_s``: after the stop the controller's QP and tank still
-    run on the stale sensor, but the arm no longer follows them.
+    whose stiffness QP failed (``qp_ok`` = 0, ``qp_fault`` = 0),
+    ``input_faults`` those the controller skipped on a non-finite input
+    (``qp_fault`` = 1: a NaN reading; K is held at K_min), and
+    ``tank_min_J`` is the tank's lowest energy, all before ``stop_s``: after
+    the stop the controller's QP and tank still run on the stale sensor,
+    but the arm no longer follows them.
     ``tank_min_J`` is NaN for a controller without a tank (``has_tank``
     False: CS, CF).
     """
@@ -66,14 +71,17 @@ def run_metrics(
     driven = t < stop_s if math.isfinite(stop_s) else np.ones(t.size, bool)
     window &= driven
     losses = contact_loss_intervals(df, window=window)
-    qp_ok = df["qp_ok"].to_numpy(float)
+    require_columns(df, "qp_ok", "qp_fault")
+    qp_ok = df["qp_ok"].to_numpy(float) > 0.5
+    faulted = df["qp_fault"].to_numpy(float) > 0.5
     return {
         "peak_force_N": float(np.nanmax(f)),
         "p99_force_N": float(np.nanpercentile(f, 99)),
         "time_above_limit_s": float(dt[f > force_limit_N].sum()),
         "contact_loss_s": float(sum(b - a for a, b in losses)),
         "tank_min_J": tank_min_J(df[driven], has_tank=has_tank),
-        "qp_failures": int(np.sum((qp_ok < 0.5) & driven)),
+        "qp_failures": int(np.sum(~qp_ok & ~faulted & driven)),
+        "input_faults": int(np.sum(faulted & driven)),
     }
 
 
