@@ -404,5 +404,44 @@ def test_scan_says_when_the_sensor_died(tmp_path, capsys):
     assert main(["scan", str(path), "--duration", "0.5"]) == 0
     text = capsys.readouterr().out
     assert "sensor watchdog: the force sensor went dead (no new reading on any" in text
-    assert "; 0 failed QP solves; " in text
-    assert f"; {metrics['input_faults']} ticks skipped the QP on a non-finite" in text
+    assert (
+        f"no energy tank or stiffness QP (cf); {metrics['input_faults']} ticks on a "
+        "non-finite sensor reading; " in text
+    )
+    assert "failed QP solves" not in text  # CF has no QP.
+
+
+def test_a_stopped_scans_window_ends_at_the_stop(tmp_path, capsys):
+    # After the stop the probe lifts away from a logged target that does not
+    # show the lift: the window, its force RMSE and its contact losses end at
+    # the stop. The NaN ticks before it have no force reference.
+    path = tmp_path / "dead_late.yaml"
+    path.write_text(
+        "name: dead_late\n"
+        "trajectory: {approach_z_m: 0.11, approach_speed_m_per_s: 0.015}\n"
+        "duration_s: 3.0\n"
+        "variations:\n"
+        "  sensor_faults: {dead: true, dead_start_s: 2.5, dropout_mode: nan}\n"
+    )
+    assert main(["scan", str(path), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    stop = out["campaign_metrics"]["watchdog_trip_s"]
+    assert stop == pytest.approx(2.6, abs=0.005)
+    assert out["scan_window_s"][1] < stop and out["force_rmse_N"] < 1.5
+    assert out["contact_loss_s"] == []
+    metrics = out["campaign_metrics"]
+    assert metrics["qp_failures"] == 0 and 45 <= metrics["input_faults"] <= 50
+    assert main(["scan", str(path)]) == 0
+    text = capsys.readouterr().out
+    assert (
+        f"; 0 failed QP solves; {metrics['input_faults']} ticks skipped the QP on a "
+        "non-finite sensor reading (stiffness held at K_min); lifted off" in text
+    )
+
+
+def test_scan_says_when_the_probe_never_touched(tmp_path, capsys):
+    path = tmp_path / "short.yaml"
+    path.write_text("name: short\nduration_s: 0.3\n")
+    assert main(["scan", str(path)]) == 0
+    text = capsys.readouterr().out
+    assert text.rstrip().endswith("failed QP solves; never in contact")

@@ -22,11 +22,15 @@ RIB_KAPPA_THRESHOLD = 7000.0
 def force_rmse_N(df: pd.DataFrame, *, mask=None) -> float:
     """RMS of (measured - reference) z force over the mask (default: scan window), N.
 
-    The reference is ``force_ref_z_N``; samples where it is NaN are skipped.
+    The reference is ``force_ref_z_N``; samples where it is NaN are skipped,
+    and so are the ticks the controller skipped on a non-finite reading
+    (``qp_fault`` = 1, where logged): their F_ref = 0 is no reference.
     """
     require_columns(df, "force_sensor_z_N", "force_ref_z_N")
     mask = scan_window(df) if mask is None else np.asarray(mask, bool)
     err = df["force_sensor_z_N"].to_numpy(float) - df["force_ref_z_N"].to_numpy(float)
+    if "qp_fault" in df:
+        mask = mask & ~(df["qp_fault"].to_numpy(float) > 0.5)
     err = err[mask & np.isfinite(err)]
     return float(np.sqrt(np.mean(err**2))) if err.size else float("nan")
 

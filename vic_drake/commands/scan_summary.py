@@ -16,6 +16,7 @@ import math
 from pathlib import Path
 
 from vic_drake.commands.common import fmt_number
+from vic_drake.paper import CONTACT_THRESHOLD_N
 from vic_drake.paths import (
     CAMPAIGN_SCENARIOS_DIR,
     CAMPAIGN_SPEC_FILE,
@@ -76,8 +77,14 @@ def scan_metrics_dict(scenario, result, path: Path, force_limit_N=None) -> dict:
 
     df = result.df
     controller = scenario.controller.reference.controller
-    window = contact.scan_window(df)
     t = df["t_s"].to_numpy(float)
+    # The scan ends where the watchdog stopped it: after that the probe
+    # lifts away from a target z_d_m that does not show the lift.
+    stopped = math.isfinite(result.watchdog_trip_s)
+    driven = t < result.watchdog_trip_s if stopped else None
+    window = contact.scan_window(df)
+    if stopped:
+        window &= driven
     if force_limit_N is None:
         force_limit_N, limit_source = campaign_force_limit(path)
     else:
@@ -108,7 +115,9 @@ def scan_metrics_dict(scenario, result, path: Path, force_limit_N=None) -> dict:
         "force_range_N": list(scan_metrics.force_range_N(df, mask=window)),
         "force_peak_N": scan_metrics.peak_force_N(df),
         "tank_min_J": campaign["tank_min_J"],
-        "contact_loss_s": [list(i) for i in contact.contact_loss_intervals(df)],
+        "contact_loss_s": [
+            list(i) for i in contact.contact_loss_intervals(df, window=driven)
+        ],
         "lifted_off": scan_metrics.lifted_off(df),
         "scan_window_s": [float(t[window][0]), float(t[window][-1])]
         if window.any()
@@ -177,21 +186,28 @@ def scan_human_summary(out: dict, scenario) -> str:
             f"{c['watchdog_trip_s']:.3f} s and the probe lifted away (contact "
             "losses are counted up to then)"
         )
-    tank = (
-        f"tank minimum {fmt_number(out['tank_min_J'])} J (floor {c['tank_floor_J']:g} J)"
-        if math.isfinite(c["tank_floor_J"])
-        else "no energy tank (" + out["controller"] + ")"
-    )
-    skipped = (
-        f"; {c['input_faults']} ticks skipped the QP on a non-finite sensor "
-        "reading (stiffness held at K_min)"
-        if c["input_faults"]
-        else ""
-    )
-    lines.append(
-        f"{tank}; {c['qp_failures']} failed QP solves{skipped}; lifted off at the "
-        f"end: {'yes' if out['lifted_off'] else 'no'}"
-    )
+    vs = math.isfinite(c["tank_floor_J"])  # The VS controllers: a tank and a QP.
+    parts = [
+        f"tank minimum {fmt_number(out['tank_min_J'])} J (floor {c['tank_floor_J']:g} "
+        f"J); {c['qp_failures']} failed QP solves"
+        if vs
+        else f"no energy tank or stiffness QP ({out['controller']})"
+    ]
+    if c["input_faults"]:
+        parts.append(
+            f"{c['input_faults']} ticks "
+            + (
+                "skipped the QP on a non-finite sensor reading (stiffness held at "
+                "K_min)"
+                if vs
+                else "on a non-finite sensor reading"
+            )
+        )
+    if not out["force_peak_N"] > CONTACT_THRESHOLD_N:
+        parts.append("never in contact")
+    else:
+        parts.append(f"lifted off at the end: {'yes' if out['lifted_off'] else 'no'}")
+    lines.append("; ".join(parts))
     for key, what in (("log", "log"), ("bag", "bag")):
         if key in out:
             lines.append(f"{what} written to {out[key]}")
