@@ -445,3 +445,32 @@ def test_scan_says_when_the_probe_never_touched(tmp_path, capsys):
     assert main(["scan", str(path)]) == 0
     text = capsys.readouterr().out
     assert text.rstrip().endswith("failed QP solves; never in contact")
+
+
+def test_scan_notes_a_fault_set_after_the_runs_end(tmp_path, capsys):
+    path = tmp_path / "late.yaml"
+    path.write_text(
+        "name: late\nduration_s: 0.2\nvariations:\n"
+        "  sensor_faults: {dead: true, dead_start_s: 1000, stuck_channel: 2,"
+        " stuck_start_s: 0.1}\n"
+    )
+    assert main(["scan", str(path)]) == 0
+    err = capsys.readouterr().err
+    assert (
+        "note: variations.sensor_faults.dead_start_s (1000 s) is not before the "
+        "run's end (0.2 s): this run has no such fault" in err
+    )
+    assert "stuck_start_s" not in err  # It sticks within the run.
+    assert main(["scan", str(path), "--duration", "0.05"]) == 0
+    assert "stuck_start_s (0.1 s) is not before the run's end (0.05 s)" in (
+        capsys.readouterr().err
+    )
+
+
+def test_scan_says_an_online_runs_bag_holds_the_estimates(tmp_path, capsys):
+    path = tmp_path / "online.yaml"
+    path.write_text("name: online\nduration_s: 0.1\nstiffness_source: online\n")
+    assert main(["scan", str(path), "--bag", str(tmp_path / "bag")]) == 0
+    err = capsys.readouterr().err
+    assert "the bag's kappa and lambda columns hold the controller's online" in err
+    assert (tmp_path / "bag").is_dir()

@@ -91,6 +91,11 @@ def test_partial_yaml_keeps_defaults_and_validates_nested_values():
             r"watchdog\.dead_window_s \(0\.1 s\) must be at least twice "
             r"station\.sensor_period_s \(0\.08 s\)",
         ),
+        (
+            "stiffness_source: online\ncontroller: {reference: {controller: cf}}",
+            r"stiffness_source 'online' is for the variable-stiffness controllers "
+            r"\(vs-cf, vs-vf\).*cf does not read them",
+        ),
     ],
 )
 def test_bad_yaml_names_the_field(text, match):

@@ -5,8 +5,8 @@ online estimates against the true and the wrong maps.
 ``estimate-online`` runs the recursive least squares or the EKF tick by
 tick over a palpation log (6 columns; reference: the offline least-squares
 Hunt-Crossley fit of the whole log) or a variable-impedance scan log (31
-columns; reference: the measured GP map's kappa and lambda at the probe's
-(x, y)), and prints the median relative errors, the correlation of kappa
+columns; reference: the map's kappa and lambda the controller logged at the
+probe's (x, y): on the rig, the measured GP map), and prints the median relative errors, the correlation of kappa
 with the reference, the convergence time and the tick cost.
 
 ``compare-online`` simulates the scenario's VS-VF scan on the true map, on
@@ -74,7 +74,7 @@ def _estimate_online(args: argparse.Namespace) -> int:
     ref = (
         "offline least-squares fit of the whole log"
         if result.kind == "palpation"
-        else "measured GP map at the probe's (x, y)"
+        else "the map's kappa and lambda the controller logged at the probe's (x, y)"
     )
 
     human = "\n".join(

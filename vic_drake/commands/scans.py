@@ -370,6 +370,12 @@ def run_scan_command(args: argparse.Namespace) -> int:
     duration = None if args.duration is None else _positive(args.duration, "--duration")
     if duration is not None:
         check_scan_duration(scenario, duration)
+    simulated = scenario.total_duration_s if duration is None else duration
+    for late in scenario.variations.sensor_faults.starting_after(simulated):
+        progress(
+            f"note: variations.sensor_faults.{late} is not before the run's end "
+            f"({simulated:g} s): this run has no such fault"
+        )
     force_limit = (
         None
         if args.force_limit is None
@@ -384,6 +390,12 @@ def run_scan_command(args: argparse.Namespace) -> int:
 
         check_bag_target(args.bag, option="--bag")
         check_bag_scenario(scenario)
+        if scenario.stiffness_source == "online":
+            progress(
+                "note: with stiffness_source online the bag's kappa and lambda "
+                "columns hold the controller's online estimates, not a map: "
+                "estimate-online on this bag compares an estimator with them"
+            )
     result = run_scan(
         scenario, duration_s=duration, data_dir=args.data_dir, progress=progress
     )

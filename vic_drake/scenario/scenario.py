@@ -230,6 +230,14 @@ class Scenario:
                 f"{o}.stiffness_source must be one of {list(STIFFNESS_SOURCES)}; "
                 f"got {self.stiffness_source!r}"
             )
+        controller = self.controller.reference.controller
+        if self.stiffness_source == "online" and not controller.startswith("vs"):
+            raise VicDrakeError(
+                f"{o}.stiffness_source 'online' is for the variable-stiffness "
+                f"controllers (vs-cf, vs-vf), whose references use kappa and "
+                f"lambda; {controller} does not read them: use stiffness_source "
+                "'map' with it"
+            )
         _validate_slope(o, self)
         if self.controller_feedback not in CONTROLLER_FEEDBACKS:
             raise VicDrakeError(

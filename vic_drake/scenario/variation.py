@@ -234,6 +234,17 @@ class SensorFaultConfig:
         _check_int(o, "seed", self.seed, 0)
         return self
 
+    def starting_after(self, duration_s: float) -> list[str]:
+        """The timed faults (a stuck channel, a dead sensor) set to start at
+        or after ``duration_s``: a run that long never has them. Each as
+        "field (value s)"."""
+        late = []
+        if self.stuck_channel >= 0 and self.stuck_start_s >= duration_s:
+            late.append(f"stuck_start_s ({self.stuck_start_s:g} s)")
+        if self.dead and self.dead_start_s >= duration_s:
+            late.append(f"dead_start_s ({self.dead_start_s:g} s)")
+        return late
+
     @property
     def active(self) -> bool:
         return (
