@@ -409,6 +409,8 @@ def test_scan_says_when_the_sensor_died(tmp_path, capsys):
         "non-finite sensor reading; " in text
     )
     assert "failed QP solves" not in text  # CF has no QP.
+    # The logged sensor force is the sensor's, before the fault model.
+    assert "sensor force (the sensor's reading before the scenario's sensor" in text
 
 
 def test_a_stopped_scans_window_ends_at_the_stop(tmp_path, capsys):

@@ -3,7 +3,8 @@ the metrics (the scan's and the campaign's) and the human summary.
 
 Two forces are reported, under distinct names. ``force_peak_N`` (and
 ``force_range_N``, ``force_rmse_N``) is the force sensor's pressing force,
-with its noise, as the controller saw it. ``campaign_metrics`` holds a
+with its noise and lag; the scenario's ``variations.sensor_faults`` act after
+the sensor, on what the controller reads, so they are not in it. ``campaign_metrics`` holds a
 campaign row's metrics (:func:`vic_drake.experiments.campaign.run_metrics`):
 its ``peak_force_N`` is the tissue's force on the probe (the force on the
 patient), so a campaign run replayed with ``vic-drake scan`` prints the peak
@@ -26,8 +27,8 @@ SCAN_DESCRIPTION = (
     "Simulates one scenario file (the station, phantom, controller, trajectory "
     "and variations of a scan; diagrams/*.yaml are the paper's runs) and prints "
     "its metrics. Two forces, under distinct names: the sensor's pressing force "
-    "(force_peak_N, force_range_N, force_rmse_N; with the sensor's noise, as the "
-    "controller saw it) and, in campaign_metrics, a campaign row's metrics, whose "
+    "(force_peak_N, force_range_N, force_rmse_N; with the sensor's noise and lag, "
+    "before the scenario's sensor_faults, which act on the controller's input) and, in campaign_metrics, a campaign row's metrics, whose "
     "peak_force_N is the tissue's force on the patient (a campaign run replayed "
     "here prints the campaign's peak). force_range_N and force_rmse_N cover the "
     "scan window (first contact + 1 s until the final lift; null when a short "
@@ -141,7 +142,13 @@ def scan_human_summary(out: dict, scenario) -> str:
         f"{fmt_number(c['peak_force_N'])} N, p99 {fmt_number(c['p99_force_N'])} N, "
         f"{fmt_number(c['time_above_limit_s'], '.2f')} s above {c['force_limit_N']:g} N "
         f"({c['force_limit_source']})",
-        f"sensor force (with its noise; force_peak_N): peak {fmt_number(out['force_peak_N'])} N",
+        "sensor force ("
+        + (
+            "the sensor's reading before the scenario's sensor faults"
+            if scenario.variations.sensor_faults.active
+            else "with its noise"
+        )
+        + f"; force_peak_N): peak {fmt_number(out['force_peak_N'])} N",
     ]
     if window is None:
         lines.append(
