@@ -473,6 +473,9 @@ def test_scan_says_an_online_runs_bag_holds_the_estimates(tmp_path, capsys):
     path = tmp_path / "online.yaml"
     path.write_text("name: online\nduration_s: 0.1\nstiffness_source: online\n")
     assert main(["scan", str(path), "--bag", str(tmp_path / "bag")]) == 0
-    err = capsys.readouterr().err
-    assert "the bag's kappa and lambda columns hold the controller's online" in err
+    captured = capsys.readouterr()
+    assert "the bag's kappa and lambda columns hold the controller's online" in (
+        captured.err
+    )
+    assert captured.out.startswith("online (vs-vf online): ")  # The map-free arm.
     assert (tmp_path / "bag").is_dir()

@@ -134,9 +134,12 @@ def scan_human_summary(out: dict, scenario) -> str:
     """The scan's result in words (what prints without --json)."""
     c = out["campaign_metrics"]
     window = out["scan_window_s"]
+    online = scenario.stiffness_source == "online"
     end = float(scenario.trajectory.end_time_s)
     lines = [
-        f"{out['scenario']} ({out['controller']}): {out['duration_s']:.2f} s "
+        f"{out['scenario']} ({out['controller']}"
+        + (" online" if online else "")
+        + f"): {out['duration_s']:.2f} s "
         f"simulated, RTF {out['rtf']:.2f}",
         f"force on the patient (tissue force; the campaign's peak_force_N): peak "
         f"{fmt_number(c['peak_force_N'])} N, p99 {fmt_number(c['p99_force_N'])} N, "
@@ -166,7 +169,9 @@ def scan_human_summary(out: dict, scenario) -> str:
         rmse = (
             "no force reference (CS)"
             if out["controller"] == "cs"
-            else f"RMSE against the reference {fmt_number(out['force_rmse_N'])} N"
+            else "RMSE against the reference"
+            + (" (built on the online estimates)" if online else "")
+            + f" {fmt_number(out['force_rmse_N'])} N"
         )
         lines.append(
             f"scan window {window[0]:.2f}-{window[1]:.2f} s: sensor force "
