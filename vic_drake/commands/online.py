@@ -83,7 +83,13 @@ def _estimate_online(args: argparse.Namespace) -> int:
             f"force paired with the position {result.lag_s * 1e3:.1f} ms earlier",
             f"reference: {ref}",
             f"kappa: median relative error {fmt_number(s['kappa_rel_err_median'], '.3f')}, "
-            f"correlation {fmt_number(s['kappa_corr'], '.3f')}, at the last contact sample "
+            "correlation "
+            + (
+                "n/a (one point pressed: nothing to correlate along a path)"
+                if result.kind == "palpation"
+                else fmt_number(s["kappa_corr"], ".3f")
+            )
+            + ", at the last contact sample "
             f"{fmt_number(result.final_kappa_rel_err, '.3f')}",
             f"lambda: median relative error {fmt_number(s['lambda_rel_err_median'], '.3f')}",
             _convergence_line(s["convergence_s"]),
