@@ -140,7 +140,7 @@ def scan_human_summary(out: dict, scenario) -> str:
         f"{out['scenario']} ({out['controller']}"
         + (" online" if online else "")
         + f"): {out['duration_s']:.2f} s "
-        f"simulated, RTF {out['rtf']:.2f}",
+        f"simulated at {out['rtf']:.2f}x real time",
         f"force on the patient (tissue force; the campaign's peak_force_N): peak "
         f"{fmt_number(c['peak_force_N'])} N, p99 {fmt_number(c['p99_force_N'])} N, "
         f"{fmt_number(c['time_above_limit_s'], '.2f')} s above {c['force_limit_N']:g} N "

@@ -314,7 +314,7 @@ def compare_real_summary(name: str, out: dict) -> str:
     contact loss and peaks it is judged on."""
     kz = "n/a" if out.get("kz_corr") is None else f"{out['kz_corr']:.3f}"
     lines = [
-        f"{name} ({out['controller']}, {out['duration_s']:.1f} s, RTF {out['rtf']:.2f}): "
+        f"{name} ({out['controller']}, {out['duration_s']:.1f} s, {out['rtf']:.2f}x real time): "
         f"force RMSE {out['force_rmse_N']:.3f} N, peak error "
         f"{out['force_peak_err_N']:.3f} N, z RMSE {out['z_rmse_mm']:.2f} mm, K_z corr {kz}"
     ]
