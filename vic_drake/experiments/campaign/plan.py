@@ -9,21 +9,19 @@ runs a resumed campaign still has to do.
 from __future__ import annotations
 
 import copy
-import re
-from dataclasses import dataclass, fields, is_dataclass
+from dataclasses import dataclass
 
 import numpy as np
 
 from vic_drake.errors import VicDrakeError
+from vic_drake.experiments.campaign.fields import (
+    CONTROLLERS,
+    apply_controller,
+    set_field,
+)
 from vic_drake.experiments.campaign.spec import CONTROLLER_FACTOR, CampaignSpec
-from vic_drake.experiments.paper_scenarios import synthetic_scenario
 from vic_drake.scenario import Scenario, dumps_scenario, loads_scenario
 from vic_drake.tissue.phantom.population import sample_patient
-
-#: The four controllers a ``controller`` factor may choose.
-CONTROLLERS = ("cs", "cf", "vs-cf", "vs-vf")
-
-_INDEXED = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)\[(\d+)\]$")
 
 
 @dataclass(frozen=True)
@@ -59,73 +57,6 @@ class RunPlan:
     def scenario(self) -> Scenario:
         """The run's exact scenario (what ``vic-drake scan`` replays)."""
         return run_scenario(self.spec, loads_scenario(self.base_yaml), self.index)[0]
-
-
-def set_field(scenario: Scenario, path: str, value) -> None:
-    """Sets a dotted field path (``a.b[2].c``) of a scenario, type-checked.
-
-    Raises:
-        VicDrakeError: an unknown field, or a value of the wrong kind.
-    """
-    obj = scenario
-    parts = path.split(".")
-    for k, part in enumerate(parts):
-        last = k == len(parts) - 1
-        m = _INDEXED.match(part)
-        name, index = (m.group(1), int(m.group(2))) if m else (part, None)
-        if not (is_dataclass(obj) and name in {f.name for f in fields(obj)}):
-            raise VicDrakeError(f"factor {path!r}: the scenario has no field {part!r}")
-        if index is not None:
-            seq = getattr(obj, name)
-            if not isinstance(seq, list) or index >= len(seq):
-                raise VicDrakeError(f"factor {path!r}: {name} has no item {index}")
-            if last:
-                seq[index] = _coerce(path, seq[index], value)
-                return
-            obj = seq[index]
-        elif last:
-            setattr(obj, name, _coerce(path, getattr(obj, name), value))
-        else:
-            obj = getattr(obj, name)
-
-
-#: The labels of a true/false field's factor (strings: quoted in YAML).
-BOOL_LABELS = {"true": True, "false": False}
-
-
-def _coerce(path: str, current, value):
-    """The value in the kind of the field it replaces."""
-    if isinstance(current, bool):
-        if value not in BOOL_LABELS:
-            raise VicDrakeError(
-                f"factor {path!r} is true/false: it takes the labels "
-                f"{list(BOOL_LABELS)} (quoted in YAML); got {value!r}"
-            )
-        return BOOL_LABELS[value]
-    if isinstance(current, str):
-        if not isinstance(value, str):
-            raise VicDrakeError(
-                f"factor {path!r} takes labels (strings); got {value!r}"
-            )
-        return value
-    if isinstance(value, str):
-        raise VicDrakeError(f"factor {path!r} takes numbers; got {value!r}")
-    if isinstance(current, int):
-        return int(round(value))
-    if isinstance(current, (float, type(None))):
-        return float(value)
-    raise VicDrakeError(f"factor {path!r}: a {type(current).__name__} cannot be varied")
-
-
-def apply_controller(scenario: Scenario, name: str) -> None:
-    """Gives the scenario the paper's controller and FDCC settings of ``name``."""
-    if name not in CONTROLLERS:
-        raise VicDrakeError(
-            f"controller factor: {name!r} is not one of {list(CONTROLLERS)}"
-        )
-    ref = synthetic_scenario(name)
-    scenario.controller = copy.deepcopy(ref.controller)
-    scenario.fdcc = copy.deepcopy(ref.fdcc)
 
 
 def _draw(spec: CampaignSpec, index: int) -> dict:

@@ -2,7 +2,9 @@
 
 A campaign YAML (``campaigns/*.yaml``) is loaded with ``yaml_load_typed``
 into :class:`CampaignSpec`; :func:`load_campaign_spec` checks it and every
-factor against the base scenario before any run starts.
+factor's whole range against the base scenario before any run starts
+(:func:`check_factor_ranges`), so a bad range or label fails whatever
+``runs`` and ``seed`` are.
 
 A factor sets one scenario field (a dotted path such as
 ``variations.motion.breathing.amplitude_m`` or ``variations.sensor_faults.bias_N[2]``)
@@ -28,13 +30,21 @@ under the same conditions, run for run (common random numbers). Without
 it, each run draws its own.
 """
 
+import copy
 import dataclasses
 import math
 import os
 from dataclasses import dataclass
+from operator import attrgetter
 from pathlib import Path
 
 from vic_drake.errors import VicDrakeError
+from vic_drake.experiments.campaign.fields import apply_controller, set_field
+from vic_drake.experiments.scan_diagram import (
+    initial_joint_positions,
+    load_scenario_phantom,
+)
+from vic_drake.scenario import Scenario, as_plain, load_scenario
 from vic_drake.scenario.io import load_typed
 
 #: The distributions a factor may have.
@@ -42,6 +52,13 @@ DISTRIBUTIONS = ("uniform", "normal", "choice", "grid")
 
 #: The factor name that selects a controller with the paper's settings.
 CONTROLLER_FACTOR = "controller"
+
+#: An unclipped normal factor (``low`` >= ``high``) has no finite bounds; its
+#: range is checked at mean -/+ this many standard deviations. A draw beyond
+#: has a probability of 2e-9 per run, and still fails that run's own check
+#: in :func:`~.plan.plan_campaign`, before any run starts; clip the normal
+#: with ``low`` and ``high`` to make the check exact.
+NORMAL_CHECK_STDS = 6.0
 
 
 @dataclass
@@ -95,6 +112,24 @@ class Factor:
     def levels(self) -> list:
         """The values of a choice or grid factor."""
         return list(self.labels) if self.labels else [float(v) for v in self.values]
+
+    def extremes(self) -> list[tuple[str, object]]:
+        """The ends of what the factor can draw, as (which, value) pairs.
+
+        uniform: low and high; a clipped normal: its clip bounds (reached
+        whenever a draw falls beyond them); an unclipped normal: mean -/+
+        :data:`NORMAL_CHECK_STDS` std; choice and grid: every level.
+        """
+        if self.dist in ("choice", "grid"):
+            which = "label" if self.labels else "value"
+            return [(which, v) for v in dict.fromkeys(self.levels)]
+        if self.dist == "normal" and not self.low < self.high:
+            k = NORMAL_CHECK_STDS
+            return [
+                (f"mean - {k:g} std", self.mean - k * self.std),
+                (f"mean + {k:g} std", self.mean + k * self.std),
+            ]
+        return [("low", float(self.low)), ("high", float(self.high))]
 
 
 @dataclass
@@ -193,13 +228,130 @@ def load_campaign_spec(path: str | os.PathLike) -> tuple[CampaignSpec, Path]:
             f"campaign {spec.name!r}: base_scenario {spec.base_scenario!r} "
             f"({str(base)!r}) does not exist"
         )
+    check_factor_ranges(spec, load_scenario(base), where)
     return spec, base
+
+
+#: What the start of a run (:func:`_start`) reads of its scenario.
+_START_PARTS = ("trajectory", "station", "phantom", "variations.patient")
+
+
+def _start(scenario: Scenario, seen: set, field: str = "") -> Scenario:
+    """Validates a scenario and checks that a run of it can start: the IK of
+    the probe's start pose and the phantom (a measured map needs the data
+    folder), which a run meets only on its worker, as an error row. Those
+    two are checked once per distinct start (``seen``), and not for a
+    ``field`` outside :data:`_START_PARTS` (the start is then its arm's)."""
+    scenario.validate()
+    if field and not field.startswith(tuple(f"{p}." for p in _START_PARTS)):
+        return scenario
+    key = repr([as_plain(attrgetter(p)(scenario)) for p in _START_PARTS])
+    if key not in seen:
+        try:
+            initial_joint_positions(scenario)
+            load_scenario_phantom(scenario)
+        except VicDrakeError as exc:
+            raise VicDrakeError(f"a run with it cannot start: {exc}") from None
+        seen.add(key)
+    return scenario
+
+
+def check_factor_ranges(spec: CampaignSpec, base: Scenario, where: str) -> None:
+    """Checks every value each factor can draw against the scenario's checks.
+
+    Each factor's :meth:`Factor.extremes` (both ends of a range, every label
+    or value of a choice or grid) is set, with the planner's own
+    :func:`~.fields.set_field` (or :func:`~.fields.apply_controller`), on a
+    copy of the base scenario as a run starts it (the campaign's
+    ``duration_s``; with ``population``, the patient enabled, as the
+    reference chest; with a controller factor, on each of its arms, as a run
+    applies the controller before the other factors); the copy is then
+    validated and its start checked (:func:`_start`). The result depends on
+    the spec and the base only, not on ``runs`` or ``seed``.
+
+    Not caught here, so still by each run's own check in
+    :func:`~.plan.plan_campaign` (before any run, but only for the draws
+    made): a bad combination of two factors (one field's bound depending on
+    another's value, such as ``stiffness_source`` online needing the
+    reference's dither, or ``watchdog.dead_window_s`` against
+    ``station.sensor_period_s``); a field whose valid values are not one
+    interval (both ends valid, a value between them not); a factor against a
+    drawn patient rather than the reference chest; an unclipped normal's
+    draw beyond :data:`NORMAL_CHECK_STDS`. A start that fails between two
+    good ends (an IK target crossing the arm's unreachable core) is not
+    caught before its run at all: it is that run's error row.
+
+    Raises:
+        VicDrakeError: naming the spec, the factor (index and field), the
+            value (low, high or label) and the scenario's own message.
+    """
+    seen: set = set()
+    start = copy.deepcopy(base)
+    start.duration_s = float(spec.duration_s)  # As run_scenario does.
+    if spec.population:
+        start.variations.patient.enabled = True
+    try:
+        _start(start, seen)
+    except VicDrakeError as exc:
+        raise VicDrakeError(
+            f"{where}: the base scenario {spec.base_scenario!r}, with the "
+            f"campaign's duration_s and population, fails: {exc}"
+        ) from None
+    arms = {"": start}
+    for i, f in enumerate(spec.factors):
+        if f.field == CONTROLLER_FACTOR:
+            arms = {v: _arm(where, i, f, w, v, start, seen) for w, v in f.extremes()}
+    for i, f in enumerate(spec.factors):
+        if f.field == CONTROLLER_FACTOR:
+            continue
+        for which, value in f.extremes():
+            errors = {}
+            for arm, scenario in arms.items():
+                try:
+                    s = copy.deepcopy(scenario)
+                    set_field(s, f.field, value)
+                    _start(s, seen, f.field)
+                except VicDrakeError as exc:
+                    errors[arm] = exc
+            if errors:
+                # Name the arms only when some of them take the value.
+                only = f" (with controller {', '.join(errors)})"
+                only = only if len(errors) < len(arms) else ""
+                raise _range_error(
+                    where, i, f, which, value, next(iter(errors.values())), only
+                )
+
+
+def _arm(where, i, f, which, label, start, seen) -> Scenario:
+    try:
+        s = copy.deepcopy(start)
+        apply_controller(s, label)
+        return _start(s, seen)
+    except VicDrakeError as exc:
+        raise _range_error(where, i, f, which, label, exc, "") from None
+
+
+def _range_error(where, i, f, which, value, exc, only) -> VicDrakeError:
+    hint = (
+        " (an unclipped normal: give it low and high to clip it)"
+        if which.startswith("mean")
+        else ""
+    )
+    return VicDrakeError(
+        f"{where}: factors[{i}] ({f.field}): its {which} {value!r}{only} is "
+        f"refused{hint}: {exc}. Every value a factor can draw is checked when "
+        "the spec loads, whatever runs and seed are (both ends of a range, every "
+        "label or value of a choice or grid, each set alone on the base "
+        "scenario); narrow the range or change the labels."
+    )
 
 
 __all__ = [
     "CONTROLLER_FACTOR",
     "DISTRIBUTIONS",
+    "NORMAL_CHECK_STDS",
     "CampaignSpec",
     "Factor",
+    "check_factor_ranges",
     "load_campaign_spec",
 ]
