@@ -15,6 +15,7 @@ import argparse
 import math
 
 from vic_drake.commands.common import Progress, add_json_option, emit, help_text
+from vic_drake.experiments.campaign.legend import console_legend
 from vic_drake.experiments.dask_cluster import add_cluster_arguments
 
 #: The keys --json prints (the command's contract), in order.
@@ -83,22 +84,25 @@ def _human(result: dict) -> str:
     else:
         session = "nothing left to run"
     width = max([10, *(len(name) for name in result["per_controller"])])
+    limit = result["force_limit_N"]
     lines = [
         f"{result['finished']}/{result['runs']} runs finished, {result['failed']} failed "
         f"({result['nan_runs']} NaN); {session}",
-        f"{'controller':<{width}} {'runs':>5} {'peakF p50':>10} {'peakF max':>10} "
-        f"{'P(exceed)':>10} {'95% CI':>16} {'loss p50 s':>10} {'tank min J':>10} "
-        f"{'wd stops':>8}",
+        f"{'controller':<{width}} {'runs':>5} {'no contact':>10} {'peakF p50':>10} "
+        f"{'peakF max':>10} {f'P(>{limit:g} N)':>10} {'95% CI':>16} "
+        f"{'loss p50 s':>10} {'tank min J':>10} {'wd stops':>8}",
     ]
     for name, v in result["per_controller"].items():
         lo, hi = v["exceed_prob_ci95"]
         ci = f"[{_num(lo, 0, 3)}, {_num(hi, 0, 3)}]"
         lines.append(
-            f"{name:<{width}} {v['runs']:>5} {_num(v['peak_force_N_p50'], 10, 2)} "
+            f"{name:<{width}} {v['runs']:>5} {v['no_contact_runs']:>10} "
+            f"{_num(v['peak_force_N_p50_contact'], 10, 2)} "
             f"{_num(v['peak_force_N_max'], 10, 2)} {_num(v['exceed_prob'], 10, 3)} "
             f"{ci:>16} {_num(v['contact_loss_s_p50'], 10, 3)} "
             f"{_num(v['tank_min_J'], 10, 3)} {v['watchdog_stops']:>8}"
         )
+    lines += [f"  {line}" for line in console_legend(limit)]
     for c in result.get("paired", []):
         loss, over = c["contact_loss"], c["exceedance"]
         lines.append(
@@ -129,10 +133,12 @@ def run_campaign_command(args: argparse.Namespace) -> int:
         name: {key: v[key] for key in CONTROLLER_KEYS}
         for name, v in result["per_controller"].items()
     }
-    # The paired comparison and the watchdog's stops are in summary.json and
-    # the table in words; --json keeps its keys.
+    # The paired comparison, the watchdog's stops, the runs without contact
+    # and the force limit are in summary.json and the table in words; --json
+    # keeps its keys.
     human = {
         **out,
+        "force_limit_N": result["force_limit_N"],
         "per_controller": result["per_controller"],
         "paired": result.get("paired", []),
     }

@@ -211,6 +211,7 @@ def _result(session_runs: int, finished: int = 16) -> dict:
         "wall_s": 15.0,
         "runs_per_hour": session_runs / 15.0 * 3600,
         "workers": 2,
+        "force_limit_N": 15.0,
         "per_controller": per_controller(_rows(), 15.0),
     }
 
@@ -294,3 +295,101 @@ def test_a_paired_campaign_summarises_its_arms_run_for_run(tmp_path):
     assert "Paired arms" in page and "<td>0 / 2 / 0 (p = " in page
     unpaired = CampaignSpec(runs=4)
     assert "paired" not in engine.summary_dict(unpaired, rows)
+
+
+def _small_campaign():
+    """An 8-run campaign's rows (2 per controller) and its summary; vs-cf's
+    first run was stopped before it touched the patient."""
+    spec = CampaignSpec(
+        name="mini",
+        description="a dead sensor, the four controllers, 200 runs of 4 s",
+        runs=8,
+        duration_s=4.0,
+    )
+    rows = pd.DataFrame(
+        {
+            "run_id": [f"run_{i:05d}" for i in range(8)],
+            "index": range(8),
+            "status": ["ok"] * 8,
+            "error": [""] * 8,
+            "factor.controller": ["cs", "cf", "vs-cf", "vs-vf"] * 2,
+            "factor.amp": [
+                0.0102949,
+                0.0116131,
+                0.0035657,
+                0.0076874,
+                0.0041175,
+                0.0120750,
+                0.0118827,
+                0.0106774,
+            ],
+            "factor.mode": ["hold", "nan"] * 4,
+            "peak_force_N": [6.84, 10.34, 0.0, 6.61, 5.80, 7.37, 7.80, 4.26],
+            "contact_loss_s": [0.0] * 8,
+            "tank_min_J": [math.nan, math.nan, 0.465, 0.484] * 2,
+            "watchdog_trip_s": [
+                math.nan,
+                math.nan,
+                0.964,
+                1.32,
+                3.29,
+                1.83,
+                3.74,
+                1.01,
+            ],
+            "watchdog_cause": ["", "", "all", "all", "all", "all", "all", "all"],
+            "qp_failures": [0] * 8,
+            "input_faults": [0, 114, 98, 0, 0, 0, 98, 73],
+        }
+    )
+    return spec, rows, engine.summary_dict(spec, rows)
+
+
+def _tables(page: str) -> list[str]:
+    return page.split("<table>")[1:]
+
+
+def test_a_small_campaigns_factor_effects_say_too_few_runs(tmp_path):
+    spec, rows, summary = _small_campaign()
+    page = summary_html(tmp_path, spec, rows, summary)
+    # Per controller, the runs that touched the patient (vs-cf's other did not).
+    assert (
+        "too few runs per controller (cf: 2, cs: 2, vs-cf: 1, vs-vf: 2)" in page.lower()
+    )
+    assert "1 run without contact" in page
+    # Every table has a body; no factor value is shown as a label.
+    assert all("<td>" in t.split("</table>")[0] for t in _tables(page))
+    assert "0.0102949" not in page and "hold:" not in page
+
+
+def test_the_summary_page_explains_its_columns_with_the_force_limit(tmp_path):
+    spec, rows, summary = _small_campaign()
+    page = summary_html(tmp_path, spec, rows, summary)
+    legend = page.split("<h2>Per controller</h2>")[1].split("<h2>")[0]
+    assert "15 N" in legend and "force limit" in legend
+    for words in ("peak F", "tank min", "—", "no energy tank", "tissue"):
+        assert words in legend, words
+    # The runs as run, beside the spec's own words (which say 200).
+    assert "8 runs of 4 s" in page
+
+
+def test_runs_that_never_touched_are_counted_in_the_table_and_the_console(tmp_path):
+    spec, rows, summary = _small_campaign()
+    assert summary["per_controller"]["vs-cf"]["no_contact_runs"] == 1
+    page = summary_html(tmp_path, spec, rows, summary)
+    per_controller_table = _tables(page)[0]
+    assert "<th>never touched the patient</th>" in per_controller_table
+    assert "<tr><td>vs-cf</td><td>2</td><td>1</td><td>7.8</td>" in per_controller_table
+    result = {
+        **summary,
+        "session_runs": 8,
+        "wall_s": 40.0,
+        "runs_per_hour": 720.0,
+        "workers": 1,
+    }
+    text = _human(result)
+    header = text.splitlines()[1].split()
+    assert "P(>15" in header and "contact" in header
+    vs = next(line.split() for line in text.splitlines() if line.startswith("vs-cf "))
+    assert vs[1:4] == ["2", "1", "7.80"]
+    assert "15 N" in text.split("wd stops", 1)[1]  # The legend under the table.

@@ -55,9 +55,23 @@ def test_per_controller_counts_scored_runs_only():
 
 
 def test_factor_effects_and_worst_runs():
+    # Three runs of cs: too few for a rank correlation (MIN_EFFECT_RUNS).
     effects = factor_effects(_rows())
     cs = next(e for e in effects if e["controller"] == "cs")
-    assert cs["spearman"] == pytest.approx(1.0)
+    assert cs == {"factor": "amp", "controller": "cs", "kind": "too_few", "runs": 3}
+    five = pd.DataFrame(
+        {
+            "status": ["ok"] * 6,
+            "factor.controller": ["cs"] * 6,
+            "factor.amp": [0.015, 0.005, 0.010, 0.020, 0.0, 0.025],
+            "peak_force_N": [13.0, 11.0, 12.0, 14.0, 10.0, 30.0],
+        }
+    )
+    (cs,) = factor_effects(five)
+    assert cs["kind"] == "numeric" and cs["spearman"] == pytest.approx(1.0)
+    # Thirds of the amplitudes 0..0.025: <= 0.00833 and >= 0.01667.
+    assert cs["low_third_median"] == pytest.approx(10.5)
+    assert cs["high_third_median"] == pytest.approx(22.0)
     worst = worst_runs(_rows(), n=3)
     assert list(worst["run_id"]) == ["run_00005", "run_00004", "run_00002"]
 
@@ -96,3 +110,63 @@ def test_paired_arms_compare_run_for_run():
 def test_paired_arms_need_a_grid_of_two_or_more():
     assert paired_arms(_paired_rows(), 0, 15.0) == []
     assert paired_arms(_paired_rows().iloc[:0], 2, 15.0) == []
+
+
+def _small_rows(runs_per_controller: int = 2) -> pd.DataFrame:
+    """A campaign's rows with few runs per controller (as an 8-run campaign of
+    the four controllers); vs-cf's first run never touched the patient."""
+    names = ["cs", "cf", "vs-cf", "vs-vf"]
+    n = 4 * runs_per_controller
+    peaks = [6.8, 10.3, 0.0, 6.6, 5.8, 7.4, 7.8, 4.3] * runs_per_controller
+    return pd.DataFrame(
+        {
+            "run_id": [f"run_{i:05d}" for i in range(n)],
+            "index": range(n),
+            "status": ["ok"] * n,
+            "error": [""] * n,
+            "factor.controller": names * runs_per_controller,
+            "factor.amp": [0.001 * (i + 1) + 0.0001 * i * i for i in range(n)],
+            "factor.mode": ["hold", "nan"] * (n // 2),
+            "factor.dead": ["true"] * n,
+            "peak_force_N": peaks[:n],
+            "contact_loss_s": [0.0] * n,
+            "tank_min_J": [float("nan")] * n,
+        }
+    )
+
+
+def test_few_runs_per_controller_are_too_few_for_factor_effects():
+    effects = factor_effects(_small_rows(2))
+    # Two runs per controller: no rank correlation, no per-level medians, and
+    # a numeric factor is never a list of its values as labels.
+    assert {e["kind"] for e in effects} == {"too_few"}
+    assert {(e["controller"], e["runs"]) for e in effects} == {
+        (c, 2) for c in ("cs", "cf", "vs-cf", "vs-vf")
+    }
+
+
+def test_a_numeric_factor_with_two_values_is_numeric():
+    rows = _small_rows(3)
+    # Two values only (as a grid of two), each controller's 0.005, 0.010, 0.005.
+    rows["factor.amp"] = [0.005] * 4 + [0.010] * 4 + [0.005] * 4
+    rows["factor.mode"] = ["hold"] * 4 + ["nan"] * 4 + ["hold"] * 4
+    rows = pd.concat([rows, rows.assign(index=rows["index"] + 12)])
+    effects = factor_effects(rows)
+    amp = [e for e in effects if e["factor"] == "amp"]
+    assert {e["kind"] for e in amp} == {"numeric"}
+    mode = next(e for e in effects if e["factor"] == "mode" and e["controller"] == "cs")
+    assert mode["kind"] == "levels" and mode["runs"] == {"hold": 4, "nan": 2}
+    assert mode["medians"] == {"hold": 6.8, "nan": 5.8}
+    dead = [e for e in effects if e["factor"] == "dead"]
+    assert {e["kind"] for e in dead} == {"constant"} and dead[0]["value"] == "true"
+
+
+def test_runs_that_never_touched_the_patient_are_counted_not_dropped():
+    pc = per_controller(_small_rows(2), force_limit_N=7.0)
+    vs = pc["vs-cf"]
+    assert vs["no_contact_runs"] == 1 and pc["cs"]["no_contact_runs"] == 0
+    # The median of the runs in contact; the key of every run stays.
+    assert vs["peak_force_N_p50_contact"] == 7.8
+    assert vs["peak_force_N_p50"] == pytest.approx(3.9)
+    # The run without contact stays in the exceedance's denominator.
+    assert vs["exceed_prob"] == 0.5

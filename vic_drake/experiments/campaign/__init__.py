@@ -3,8 +3,9 @@
 :mod:`.spec` (the campaign YAML), :mod:`.plan` (each run's factors and
 scenario), :mod:`.run` (one run on a worker, its metrics), :mod:`.engine`
 (the runs on Dask, rows on disk, resume; the cluster itself is
-:mod:`vic_drake.experiments.dask_cluster`), :mod:`.stats` and
-:mod:`.report` (summary.json, summary.html, results.parquet).
+:mod:`vic_drake.experiments.dask_cluster`), :mod:`.stats`,
+:mod:`.report` (summary.json, summary.html, results.parquet) and
+:mod:`.legend` (what each column of their tables means).
 """
 
 from vic_drake.experiments.campaign.engine import read_rows, run_campaign

@@ -51,6 +51,7 @@ from vic_drake.experiments.campaign.run import failed_row
 from vic_drake.experiments.campaign.spec import CampaignSpec, load_campaign_spec
 from vic_drake.experiments.campaign.stats import paired_arms, per_controller
 from vic_drake.experiments.dask_cluster import dask_session
+from vic_drake.paper import CONTACT_THRESHOLD_N
 from vic_drake.paths import (
     CAMPAIGN_SCENARIOS_DIR,
     CAMPAIGN_SPEC_FILE,
@@ -277,7 +278,8 @@ def _submit(
 
 
 def summary_dict(spec: CampaignSpec, rows: pd.DataFrame) -> dict:
-    """runs, finished, failed, nan_runs and per_controller of a campaign's
+    """runs, finished, failed, nan_runs, the force limit and the contact
+    threshold (N) the statistics use, and per_controller of a campaign's
     rows; with ``paired``, also paired (:func:`~.stats.paired_arms`)."""
     status = rows["status"] if not rows.empty else pd.Series([], dtype=str)
     summary = {
@@ -286,6 +288,8 @@ def summary_dict(spec: CampaignSpec, rows: pd.DataFrame) -> dict:
         # Failed: raised or produced NaN (nan_runs counts the latter alone).
         "failed": int((status != "ok").sum()),
         "nan_runs": int((status == "nan").sum()),
+        "force_limit_N": spec.force_limit_N,
+        "contact_threshold_N": CONTACT_THRESHOLD_N,
         "per_controller": per_controller(rows, spec.force_limit_N),
     }
     if spec.paired:

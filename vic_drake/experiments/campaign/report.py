@@ -2,8 +2,10 @@
 
 The page shows each controller's distribution of peak force and contact
 loss, the probability of exceeding the force limit with its 95 % Wilson
-interval, each factor's effect on the peak force, and the ten worst runs
-with the command that replays each.
+interval, a legend of those columns, each factor's effect on the peak force
+(or, with too few runs per controller, that there are too few), and the ten
+worst runs with the command that replays each. A table is never shown
+without rows: where there is nothing to tabulate the page says why.
 """
 
 from __future__ import annotations
@@ -19,8 +21,18 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from vic_drake.experiments.campaign.legend import (
+    controller_legend,
+    exceed_label,
+    worst_runs_legend,
+)
 from vic_drake.experiments.campaign.spec import CampaignSpec
-from vic_drake.experiments.campaign.stats import factor_effects, worst_runs
+from vic_drake.experiments.campaign.stats import (
+    MIN_EFFECT_RUNS,
+    factor_effects,
+    worst_runs,
+)
+from vic_drake.paper import CONTACT_THRESHOLD_N
 
 
 def _atomic(path: Path, data: bytes) -> None:
@@ -61,15 +73,21 @@ def distribution_figure(rows: pd.DataFrame, force_limit_N: float):
     names = sorted(ok["factor.controller"].astype(str).unique())
     fig, axes = plt.subplots(1, 2, figsize=(10, 3.5))
     for ax, col, label in (
-        (axes[0], "peak_force_N", "peak force on the patient (N)"),
+        (axes[0], "peak_force_N", "peak force on the patient,\nruns that touched (N)"),
         (axes[1], "contact_loss_s", "contact loss in the scan (s)"),
     ):
-        data = [
-            ok.loc[ok["factor.controller"] == n, col].dropna().to_numpy() for n in names
-        ]
+        data, ticks = [], []
+        for n in names:
+            v = ok.loc[ok["factor.controller"] == n, col].dropna().to_numpy(float)
+            untouched = 0
+            if col == "peak_force_N":  # A run that never touched has no peak.
+                untouched = int(np.sum(v <= CONTACT_THRESHOLD_N))
+                v = v[v > CONTACT_THRESHOLD_N]
+            data.append(v)
+            ticks.append(f"{n}\n({untouched} no contact)" if untouched else n)
         if names:
             ax.boxplot(data, showfliers=True)
-            ax.set_xticks(range(1, len(names) + 1), names)
+            ax.set_xticks(range(1, len(names) + 1), ticks)
         ax.set_ylabel(label)
     axes[0].axhline(force_limit_N, color="r", ls="--", label="force limit")
     axes[0].legend()
@@ -94,7 +112,10 @@ def effect_figure(rows: pd.DataFrame, factor: str):
     return fig
 
 
-def _table(header, body) -> str:
+def _table(header, body, *, empty: str = "Nothing to show.") -> str:
+    """A table, or the sentence ``empty`` where it has no rows."""
+    if not body:
+        return f"<p>{html.escape(empty)}</p>"
     head = "".join(f"<th>{html.escape(h)}</th>" for h in header)
     rows = "".join("<tr>" + "".join(f"<td>{c}</td>" for c in r) + "</tr>" for r in body)
     return f"<table><tr>{head}</tr>{rows}</table>"
@@ -131,58 +152,129 @@ def _paired_html(paired: list[dict], force_limit_N: float) -> str:
             ]
             for c in paired
         ],
+        empty="No pair of runs in which both arms finished.",
     )
 
 
-def summary_html(
-    out: Path, spec: CampaignSpec, rows: pd.DataFrame, summary: dict
-) -> str:
-    """The campaign's summary page."""
+def _plural(n: int, word: str) -> str:
+    return f"{n} {word}{'' if n == 1 else 's'}"
+
+
+def _header(spec: CampaignSpec, summary: dict) -> list[str]:
+    """The title, the campaign as run (its spec's fields) and its outcome.
+
+    The spec's free-text description may quote other figures (a spec copied
+    and shortened keeps "200 runs of 4 s"): it is shown as the spec's words,
+    after the fields.
+    """
+    extras = "".join(
+        text
+        for flag, text in (
+            (spec.population, ", a synthetic patient per run"),
+            (spec.paired, ", the arms paired run for run"),
+        )
+        if flag
+    )
     parts = [
         f"<h1>Campaign {html.escape(spec.name)}</h1>",
-        f"<p>{html.escape(spec.description)}</p>",
-        f"<p>{summary['finished']} of {summary['runs']} runs finished, "
-        f"{summary['failed']} failed ({summary['nan_runs']} NaN); force limit "
-        f"{spec.force_limit_N} N; {spec.duration_s} s per run.</p>",
+        f"<p>As run: <b>{_plural(spec.runs, 'run')} of {spec.duration_s:g} s</b>"
+        f" (seed {spec.seed}{extras}); force limit {spec.force_limit_N:g} N on "
+        "the patient.</p>",
     ]
-    pc = summary["per_controller"]
-    parts.append("<h2>Per controller</h2>")
-    parts.append(
-        _table(
-            [
-                "controller",
-                "runs",
-                "peak F p50 (N)",
-                "peak F max (N)",
-                "P(peak > limit)",
-                "95 % interval (Wilson)",
-                "contact loss p50 (s)",
-                "tank min (J)",
-                "stopped by the sensor watchdog",
-            ],
-            [
-                [
-                    html.escape(n),
-                    v["runs"],
-                    _fmt(v["peak_force_N_p50"]),
-                    _fmt(v["peak_force_N_max"]),
-                    _fmt(v["exceed_prob"]),
-                    _fmt(v["exceed_prob_ci95"]),
-                    _fmt(v["contact_loss_s_p50"]),
-                    _fmt(v["tank_min_J"]),
-                    v["watchdog_stops"],
-                ]
-                for n, v in pc.items()
-            ],
+    if spec.description:
+        parts.append(
+            f"<p>The spec's description: <q>{html.escape(spec.description)}</q></p>"
         )
+    parts.append(
+        f"<p>{summary['finished']} of {summary['runs']} runs finished, "
+        f"{summary['failed']} failed ({summary['nan_runs']} NaN).</p>"
     )
-    if summary.get("paired"):
-        parts.append(_paired_html(summary["paired"], spec.force_limit_N))
-    if not rows.empty:
-        parts.append(_png(distribution_figure(rows, spec.force_limit_N)))
-        effects = factor_effects(rows)
-        parts.append("<h2>Factor effects on the peak force</h2>")
-        numeric = [e for e in effects if e["kind"] == "numeric"]
+    return parts
+
+
+def _legend(items: list[tuple[str, str]]) -> str:
+    return (
+        "<ul class='legend'>"
+        + "".join(
+            f"<li><b>{html.escape(k)}</b>: {html.escape(v)}</li>" for k, v in items
+        )
+        + "</ul>"
+    )
+
+
+def _controller_html(summary: dict, force_limit_N: float) -> str:
+    """The per-controller table and its legend."""
+    table = _table(
+        [
+            "controller",
+            "runs",
+            "never touched the patient",
+            "peak F p50 (N)",
+            "peak F max (N)",
+            exceed_label(force_limit_N),
+            "95 % interval (Wilson)",
+            "contact loss p50 (s)",
+            "tank min (J)",
+            "stopped by the sensor watchdog",
+        ],
+        [
+            [
+                html.escape(n),
+                v["runs"],
+                v["no_contact_runs"],
+                _fmt(v["peak_force_N_p50_contact"]),
+                _fmt(v["peak_force_N_max"]),
+                _fmt(v["exceed_prob"]),
+                _fmt(v["exceed_prob_ci95"]),
+                _fmt(v["contact_loss_s_p50"]),
+                _fmt(v["tank_min_J"]),
+                v["watchdog_stops"],
+            ]
+            for n, v in summary["per_controller"].items()
+        ],
+        empty="No run has finished.",
+    )
+    legend = (
+        _legend(controller_legend(force_limit_N)) if summary["per_controller"] else ""
+    )
+    return "<h2>Per controller</h2>" + table + legend
+
+
+def _effects_html(touched: pd.DataFrame, untouched: int) -> tuple[str, list[str]]:
+    """The factor effects on the peak force of the runs that touched the
+    patient, in words and tables; and the numeric factors whose effect was
+    computed (each gets a figure)."""
+    parts = ["<h2>Factor effects on the peak force</h2>"]
+    if untouched and not touched.empty:
+        parts.append(
+            f"<p>Over the runs that touched the patient: {_plural(untouched, 'run')} "
+            f"without contact (peak F at most {CONTACT_THRESHOLD_N:g} N) left out.</p>"
+        )
+    effects = factor_effects(touched)
+    if not effects:
+        parts.append(
+            "<p>No run touched the patient.</p>"
+            if touched.empty
+            else "<p>No factor besides the controller varies in this campaign.</p>"
+        )
+    by_kind = {
+        kind: [e for e in effects if e["kind"] == kind]
+        for kind in ("too_few", "numeric", "levels", "constant")
+    }
+    too_few = {e["controller"]: e["runs"] for e in by_kind["too_few"]}
+    if too_few:
+        counts = set(too_few.values())
+        each = ", ".join(f"{c}: {n}" for c, n in too_few.items())
+        if len(too_few) < len({e["controller"] for e in effects}):
+            which = f"for {each}"
+        else:
+            which = f"per controller ({counts.pop() if len(counts) == 1 else each})"
+        parts.append(
+            f"<p>Too few runs {which} for factor effects: they need at least "
+            f"{MIN_EFFECT_RUNS} runs of a controller (with 4, even a perfect "
+            "rank correlation is within chance).</p>"
+        )
+    if by_kind["numeric"]:
         parts.append(
             _table(
                 [
@@ -200,50 +292,113 @@ def summary_html(
                         _fmt(e["low_third_median"]),
                         _fmt(e["high_third_median"]),
                     ]
-                    for e in numeric
+                    for e in by_kind["numeric"]
                 ],
             )
         )
-        for e in (e for e in effects if e["kind"] == "levels"):
-            parts.append(
-                f"<p>{html.escape(e['factor'])} ({html.escape(e['controller'])}): "
-                + ", ".join(
-                    f"{html.escape(k)}: {_fmt(v)} N" for k, v in e["medians"].items()
-                )
-                + "</p>"
-            )
-        for factor in dict.fromkeys(e["factor"] for e in numeric):
-            parts.append(_png(effect_figure(rows, factor)))
-        parts.append("<h2>The ten worst runs</h2>")
-        worst = worst_runs(rows)
+    if by_kind["levels"]:
         parts.append(
             _table(
-                [
-                    "run",
-                    "controller",
-                    "status",
-                    "peak F (N)",
-                    "contact loss (s)",
-                    "tank min (J)",
-                    "error",
-                    "replay",
-                ],
+                ["factor", "controller", "median peak F per value (N; runs)"],
                 [
                     [
-                        r["run_id"],
-                        html.escape(str(r["factor.controller"])),
-                        r["status"],
-                        _fmt(r["peak_force_N"]),
-                        _fmt(r["contact_loss_s"]),
-                        _fmt(r["tank_min_J"]),
-                        html.escape(str(r["error"])),
-                        f"<code>{html.escape(replay_command(out, r['run_id']))}</code>",
+                        html.escape(e["factor"]),
+                        html.escape(e["controller"]),
+                        ", ".join(
+                            f"{html.escape(k)}: {_fmt(m)} ({e['runs'][k]})"
+                            for k, m in e["medians"].items()
+                        ),
                     ]
-                    for _, r in worst.iterrows()
+                    for e in by_kind["levels"]
                 ],
             )
         )
-    style = "<style>table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:2px 6px}</style>"
+    constant: dict[str, dict[str, list[str]]] = {}
+    for e in by_kind["constant"]:
+        values = constant.setdefault(e["factor"], {})
+        values.setdefault(_fmt(e["value"]), []).append(html.escape(e["controller"]))
+    if constant:
+        n_controllers = len({e["controller"] for e in effects})
+        held = [
+            f"{html.escape(f)} = {v}"
+            + ("" if len(c) == n_controllers else f" ({', '.join(c)})")
+            for f, values in constant.items()
+            for v, c in values.items()
+        ]
+        parts.append(
+            "<p>One value in a controller's runs (no effect to measure): "
+            + "; ".join(held)
+            + ".</p>"
+        )
+    numeric = list(dict.fromkeys(e["factor"] for e in by_kind["numeric"]))
+    return "".join(parts), numeric
+
+
+def _watchdog_text(r) -> str:
+    trip = r.get("watchdog_trip_s", math.nan)
+    if not isinstance(trip, float) or math.isnan(trip):
+        return "—"
+    return f"{trip:.3g} s ({html.escape(str(r.get('watchdog_cause', '')))})"
+
+
+def _worst_html(out: Path, rows: pd.DataFrame) -> str:
+    worst = worst_runs(rows)
+    table = _table(
+        [
+            "run",
+            "controller",
+            "status",
+            "peak F (N)",
+            "contact loss (s)",
+            "tank min (J)",
+            "watchdog stop",
+            "failed QP solves / skipped ticks",
+            "error",
+            "replay",
+        ],
+        [
+            [
+                r["run_id"],
+                html.escape(str(r["factor.controller"])),
+                r["status"],
+                _fmt(r["peak_force_N"]),
+                _fmt(r["contact_loss_s"]),
+                _fmt(r["tank_min_J"]),
+                _watchdog_text(r),
+                f"{_fmt(r.get('qp_failures', math.nan))} / "
+                f"{_fmt(r.get('input_faults', math.nan))}",
+                html.escape(str(r["error"])),
+                f"<code>{html.escape(replay_command(out, r['run_id']))}</code>",
+            ]
+            for _, r in worst.iterrows()
+        ],
+    )
+    legend = _legend(worst_runs_legend())
+    return "<h2>The ten worst runs</h2>" + table + legend
+
+
+def summary_html(
+    out: Path, spec: CampaignSpec, rows: pd.DataFrame, summary: dict
+) -> str:
+    """The campaign's summary page."""
+    parts = _header(spec, summary)
+    parts.append(_controller_html(summary, spec.force_limit_N))
+    if summary.get("paired"):
+        parts.append(_paired_html(summary["paired"], spec.force_limit_N))
+    if not rows.empty:
+        parts.append(_png(distribution_figure(rows, spec.force_limit_N)))
+        scored = rows[rows["status"] != "error"]
+        touched = scored[scored["peak_force_N"] > CONTACT_THRESHOLD_N]
+        untouched = int((scored["peak_force_N"] <= CONTACT_THRESHOLD_N).sum())
+        text, numeric = _effects_html(touched, untouched)
+        parts.append(text)
+        parts.extend(_png(effect_figure(touched, factor)) for factor in numeric)
+        parts.append(_worst_html(out, rows))
+    style = (
+        "<style>table{border-collapse:collapse}"
+        "td,th{border:1px solid #ccc;padding:2px 6px}"
+        ".legend{font-size:90%;max-width:60em}</style>"
+    )
     return f"<html><head><meta charset='utf-8'>{style}</head><body>{''.join(parts)}</body></html>"
 
 

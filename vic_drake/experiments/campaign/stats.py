@@ -7,8 +7,15 @@ import math
 import numpy as np
 import pandas as pd
 
+from vic_drake.paper import CONTACT_THRESHOLD_N
+
 #: z of a two-sided 95 % interval.
 Z95 = 1.959963984540054
+
+#: The fewest runs of one controller from which factor effects are computed.
+#: With n runs a perfect rank correlation has the exact two-sided p 2 / n!:
+#: 0.083 at n = 4, which chance alone gives; 0.017 at n = 5.
+MIN_EFFECT_RUNS = 5
 
 
 def wilson_interval(successes: int, n: int, z: float = Z95) -> tuple[float, float]:
@@ -49,12 +56,17 @@ def _count_finite(rows: pd.DataFrame, column: str) -> int:
 
 def per_controller(rows: pd.DataFrame, force_limit_N: float) -> dict:
     """{controller: runs, peak force p50/max, exceedance and CI, contact loss,
-    tank min, runs the sensor's watchdog stopped}.
+    tank min, runs the sensor's watchdog stopped, runs without contact}.
 
     Runs with status "error" count in ``runs`` but not in the statistics;
     a NaN run's peak force is its finite part's maximum (its row says NaN).
     ``exceed_prob`` is the share of scored runs whose peak force exceeds the
-    force limit.
+    force limit. ``no_contact_runs`` counts the scored runs whose peak force
+    never rose above :data:`~vic_drake.paper.CONTACT_THRESHOLD_N` (e.g. the
+    sensor's watchdog stopped them before the probe reached the patient):
+    they stay in ``exceed_prob`` (they did not exceed) and in
+    ``peak_force_N_p50`` (every scored run), but not in
+    ``peak_force_N_p50_contact``, the median of the runs that touched.
     """
     out = {}
     if rows.empty:
@@ -62,6 +74,7 @@ def per_controller(rows: pd.DataFrame, force_limit_N: float) -> dict:
     for name, group in rows.groupby("factor.controller", sort=True):
         scored = group[group["status"] != "error"]
         peaks = _finite(scored["peak_force_N"])
+        touched = peaks > CONTACT_THRESHOLD_N
         exceed = int(np.sum(peaks > force_limit_N))
         lo, hi = wilson_interval(exceed, peaks.size)
         out[str(name)] = {
@@ -73,48 +86,69 @@ def per_controller(rows: pd.DataFrame, force_limit_N: float) -> dict:
             "contact_loss_s_p50": _stat(scored["contact_loss_s"], np.median),
             "tank_min_J": _stat(scored["tank_min_J"], np.min),
             "watchdog_stops": _count_finite(scored, "watchdog_trip_s"),
+            "no_contact_runs": int(np.sum(~touched)),
+            "peak_force_N_p50_contact": _stat(peaks[touched], np.median),
         }
     return out
+
+
+def _is_numeric(column: pd.Series) -> bool:
+    """A numeric factor, however few values it takes (bools are labels)."""
+    return pd.api.types.is_numeric_dtype(column) and not pd.api.types.is_bool_dtype(
+        column
+    )
 
 
 def factor_effects(rows: pd.DataFrame, metric: str = "peak_force_N") -> list[dict]:
     """Each factor's effect on a metric, per controller.
 
-    Numeric factors: Spearman's rank correlation and the metric's change
-    from the factor's lowest to its highest third (median of each).
-    Label factors: the metric's median per level.
+    One entry per factor and controller, by ``kind``:
+
+    - ``too_few``: the controller has fewer than :data:`MIN_EFFECT_RUNS`
+      scored runs with the metric (``runs``): no effect is computed;
+    - ``constant``: the factor took one ``value`` in its runs;
+    - ``numeric`` (a numeric factor, whatever its number of values):
+      Spearman's rank correlation and the metric's median in the factor's
+      lowest and highest third;
+    - ``levels`` (a label factor): the metric's median and the runs per label.
     """
     effects = []
-    ok = rows[rows["status"] != "error"]
+    ok = rows[(rows["status"] != "error") & np.isfinite(rows[metric].astype(float))]
     factor_cols = [
         c for c in rows.columns if c.startswith("factor.") and c != "factor.controller"
     ]
+    groups = list(ok.groupby("factor.controller", sort=True))
     for col in factor_cols:
-        for name, group in ok.groupby("factor.controller", sort=True):
+        numeric = _is_numeric(rows[col])
+        for name, group in groups:
+            entry = {"factor": col[len("factor.") :], "controller": str(name)}
+            if numeric:  # A run without the factor's value is no point.
+                group = group[np.isfinite(group[col].to_numpy(float))]
             x = group[col]
             y = group[metric].to_numpy(float)
-            entry = {"factor": col[len("factor.") :], "controller": str(name)}
-            if pd.api.types.is_numeric_dtype(x) and x.nunique() > 2:
+            if len(group) < MIN_EFFECT_RUNS:
+                entry.update(kind="too_few", runs=int(len(group)))
+            elif x.nunique() == 1:
+                value = x.iloc[0]
+                if isinstance(value, np.generic):
+                    value = value.item()
+                entry.update(kind="constant", value=value)
+            elif numeric:
                 xv = x.to_numpy(float)
-                keep = np.isfinite(xv) & np.isfinite(y)
-                xv, yv = xv[keep], y[keep]
-                if xv.size < 3:
-                    continue
-                rho = pd.Series(xv).rank().corr(pd.Series(yv).rank())
+                rho = pd.Series(xv).rank().corr(pd.Series(y).rank())
                 lo, hi = np.quantile(xv, [1 / 3, 2 / 3])
                 entry.update(
                     kind="numeric",
                     spearman=float(rho) if np.isfinite(rho) else math.nan,
-                    low_third_median=_stat(yv[xv <= lo], np.median),
-                    high_third_median=_stat(yv[xv >= hi], np.median),
+                    low_third_median=_stat(y[xv <= lo], np.median),
+                    high_third_median=_stat(y[xv >= hi], np.median),
                 )
             else:
+                levels = group.groupby(x.astype(str), sort=True)
                 entry.update(
                     kind="levels",
-                    medians={
-                        str(k): _stat(g[metric], np.median)
-                        for k, g in group.groupby(col)
-                    },
+                    medians={k: _stat(g[metric], np.median) for k, g in levels},
+                    runs={k: int(len(g)) for k, g in levels},
                 )
             effects.append(entry)
     return effects
@@ -194,6 +228,7 @@ def worst_runs(rows: pd.DataFrame, n: int = 10) -> pd.DataFrame:
 
 
 __all__ = [
+    "MIN_EFFECT_RUNS",
     "Z95",
     "factor_effects",
     "paired_arms",
