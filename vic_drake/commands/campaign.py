@@ -15,7 +15,6 @@ import argparse
 import math
 
 from vic_drake.commands.common import Progress, add_json_option, emit, help_text
-from vic_drake.experiments.campaign.legend import console_legend
 from vic_drake.experiments.dask_cluster import add_cluster_arguments
 
 #: The keys --json prints (the command's contract), in order.
@@ -71,6 +70,8 @@ def _num(value: float, width: int, digits: int) -> str:
 
 
 def _human(result: dict) -> str:
+    from vic_drake.experiments.campaign.legend import console_legend
+
     new = result["session_runs"]
     before = result["finished"] - new
     if new:
