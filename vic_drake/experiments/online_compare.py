@@ -265,6 +265,20 @@ _COLUMNS = (
 )
 
 
+#: One line per column of :func:`comparison_table`, printed under it.
+COLUMN_LEGEND = (
+    "force RMSE vs truth: sensor z force against the reference a perfect map "
+    "gives (-kappa_true eps_d^beta); a dither's swing counts as error",
+    "vs dithered truth: the same against the true reference with the run's own "
+    "dither, the error beyond the dither",
+    "dither RMS: the dither's own part of that reference (0 without a dither)",
+    "penetration err: median |true penetration - eps_d|; kappa err: median "
+    "|kappa the reference used / kappa_true - 1|",
+    "p99 force on ribs: where the true kappa is a rib's; tank min: the lowest "
+    "tank energy (T_min is the floor); all over the scan window",
+)
+
+
 def comparison_table(scores: dict) -> str:
     """The scores as a markdown table, one row a run: ``{run: scores}``, or
     ``{run: [scores, ...]}`` from
@@ -299,6 +313,7 @@ def main(argv=None) -> None:
 
 
 __all__ = [
+    "COLUMN_LEGEND",
     "COMPARISON_RUNS",
     "ComparisonRun",
     "DITHER_HZ",

@@ -143,7 +143,7 @@ def wins_table(wins: dict[str, dict], against: str, dither_hzs) -> str:
 def comparison_report(sweep: dict[str, list[dict]], dither_hzs, against) -> str:
     """What the command prints: the table (of means and ranges over several
     frequencies) and, with ``against``, :func:`wins_table`."""
-    from vic_drake.experiments.online_compare import comparison_table
+    from vic_drake.experiments.online_compare import COLUMN_LEGEND, comparison_table
 
     if len(dither_hzs) == 1:
         text = comparison_table({run: scores[0] for run, scores in sweep.items()})
@@ -153,6 +153,7 @@ def comparison_report(sweep: dict[str, list[dict]], dither_hzs, against) -> str:
             f"Mean (min-max) over the dither frequencies {hz} Hz:\n\n"
             + comparison_table(sweep)
         )
+    text += "\n\n" + "\n".join(f"- {line}" for line in COLUMN_LEGEND)
     notes = _nan_notes(sweep)
     if notes:
         text += "\n\n" + "\n".join(notes)
@@ -356,7 +357,10 @@ def run_comparison(args: argparse.Namespace, say=None) -> dict[str, list[dict]]:
     if on_cluster and scheduler is None and workers is None:
         workers = os.cpu_count() or 1
     if on_cluster:
-        where = scheduler or f"a local cluster of {workers} worker processes"
+        where = scheduler or (
+            f"a local cluster of {workers} worker process"
+            + ("" if workers == 1 else "es")
+        )
         say(f"{n_scans} scans on {where}")
     return online_comparison_sweep(
         base,
