@@ -78,7 +78,8 @@ def _human(result: dict) -> str:
         # The time and the rate are this session's: its runs alone.
         session = (
             f"this session {new} runs in {result['wall_s']:.0f} s on "
-            f"{result['workers']} workers, {result['runs_per_hour']:.0f} runs/h"
+            f"{result['workers']} worker{'' if result['workers'] == 1 else 's'}, "
+            f"{result['runs_per_hour']:.0f} runs/h"
         )
         if before:
             session += f" ({before} finished before)"
