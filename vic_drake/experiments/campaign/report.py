@@ -71,23 +71,26 @@ def distribution_figure(rows: pd.DataFrame, force_limit_N: float):
 
     ok = rows[rows["status"] != "error"]
     names = sorted(ok["factor.controller"].astype(str).unique())
-    fig, axes = plt.subplots(1, 2, figsize=(10, 3.5))
+    # Many arms ("vs-vf no watchdog", ...): slanted names, which need height.
+    slant = len(names) > 4
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4.5 if slant else 3.5))
     for ax, col, label in (
         (axes[0], "peak_force_N", "peak force on the patient,\nruns that touched (N)"),
         (axes[1], "contact_loss_s", "contact loss in the scan (s)"),
     ):
-        data, ticks = [], []
+        data = []
         for n in names:
             v = ok.loc[ok["factor.controller"] == n, col].dropna().to_numpy(float)
-            untouched = 0
-            if col == "peak_force_N":  # A run that never touched has no peak.
-                untouched = int(np.sum(v <= CONTACT_THRESHOLD_N))
-                v = v[v > CONTACT_THRESHOLD_N]
+            if col == "peak_force_N":  # A run that never touched has no peak
+                v = v[v > CONTACT_THRESHOLD_N]  # (the table counts them).
             data.append(v)
-            ticks.append(f"{n}\n({untouched} no contact)" if untouched else n)
         if names:
             ax.boxplot(data, showfliers=True)
-            ax.set_xticks(range(1, len(names) + 1), ticks)
+            ax.set_xticks(range(1, len(names) + 1), names)
+            if slant:
+                ax.tick_params(axis="x", labelrotation=35)
+                for tick in ax.get_xticklabels():
+                    tick.set_horizontalalignment("right")
         ax.set_ylabel(label)
     axes[0].axhline(force_limit_N, color="r", ls="--", label="force limit")
     axes[0].legend()
