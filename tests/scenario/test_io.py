@@ -92,6 +92,10 @@ def test_partial_yaml_keeps_defaults_and_validates_nested_values():
             r"station\.sensor_period_s \(0\.08 s\)",
         ),
         (
+            "variations: {sensor_faults: {stuck_channel: z}}",
+            r"stuck_channel must be an int; got 'z'; allowed: -1 \(none\), 0 \(x\)",
+        ),
+        (
             "stiffness_source: online\ncontroller: {reference: {controller: cf}}",
             r"stiffness_source 'online' is for the variable-stiffness controllers "
             r"\(vs-cf, vs-vf\).*cf does not read them",

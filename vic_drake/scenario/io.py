@@ -137,6 +137,17 @@ def _record_types(tp) -> dict | None:
 _SCALARS = {float: (int, float), int: (int,), str: (str,), bool: (bool,)}
 
 
+def _allowed_values(tp, name: str) -> str:
+    """A dataclass field's allowed values in words (its ``metadata["allowed"]``),
+    or ""."""
+    if not (dataclasses.is_dataclass(tp) and isinstance(tp, type)):
+        return ""
+    for f in dataclasses.fields(tp):
+        if f.name == name:
+            return str(f.metadata.get("allowed", ""))
+    return ""
+
+
 def _first_bad_field(value, tp, path: str) -> str | None:
     """Path and problem of the first value that does not fit annotation tp."""
     hints = _record_types(tp)
@@ -149,7 +160,8 @@ def _first_bad_field(value, tp, path: str) -> str | None:
                 return f"{sub} is unknown; allowed: {sorted(hints)}"
             bad = _first_bad_field(item, hints[key], sub)
             if bad:
-                return bad
+                allowed = _allowed_values(tp, key)
+                return f"{bad}; allowed: {allowed}" if allowed else bad
         return None
     origin, args = typing.get_origin(tp), typing.get_args(tp)
     if origin in (typing.Union, types.UnionType):

@@ -185,7 +185,10 @@ class SensorFaultConfig:
     spike_rate_per_s: float = 0.0  # Single-tick spikes per second.
     spike_magnitude_N: float = 0.0  # Size of a spike, N.
     extra_latency_s: float = 0.0  # Added delay, s (rounded to control ticks).
-    stuck_channel: int = -1  # -1: none; 0, 1, 2: the axis x, y, z that sticks.
+    # -1: none; 0, 1, 2: the axis x, y, z that sticks.
+    stuck_channel: int = field(
+        default=-1, metadata={"allowed": "-1 (none), 0 (x), 1 (y) or 2 (z)"}
+    )
     stuck_start_s: float = 0.0  # When it sticks, s.
     # The sensor dies at dead_start_s: a dropout (dropout_mode) that never ends.
     dead: bool = False
