@@ -55,8 +55,6 @@ def _estimate_online(args: argparse.Namespace) -> int:
         "a ROS 2 bag folder (metadata.yaml + .db3) of the 6-column palpation or "
         "the 31-column variable-impedance layout",
     )
-    say = Progress()
-    say(f"replaying {args.bag_dir} through the {args.method.upper()} estimator")
     if args.surface_walk is not None and args.method != "ekf":
         raise VicDrakeError(
             "--surface-walk needs --method ekf (the RLS trusts the surface)"
@@ -69,6 +67,8 @@ def _estimate_online(args: argparse.Namespace) -> int:
     params = OnlineEstimatorParams(
         method=args.method, beta=args.beta, surface_walk_m_per_sqrt_s=walk
     )
+    say = Progress()
+    say(f"replaying {args.bag_dir} through the {args.method.upper()} estimator")
     result = replay_online(path, params=params, lag_s=args.lag)
     s = result.summary
     ref = (
