@@ -51,6 +51,26 @@ def test_run_scan_rejects_bad_input():
         MakeScanDiagram({"name": "not a scenario"})
     with pytest.raises(VicDrakeError, match="controller"):
         synthetic_scenario("pid")
+    with pytest.raises(VicDrakeError, match="run_scan needs a Scenario; got dict"):
+        run_scan({"name": "not a scenario"})
+
+
+@pytest.mark.parametrize(
+    "part, field, value, message",
+    [
+        ("trajectory", "scan_speed_m_per_s", -0.01, r"scan_speed_m_per_s must be > 0"),
+        ("", "seed", -3, r"Scenario\.seed must be an integer >= 0"),
+    ],
+)
+def test_a_scenario_changed_in_code_is_checked_before_it_runs(
+    part, field, value, message
+):
+    scenario = synthetic_scenario("cs")
+    setattr(getattr(scenario, part) if part else scenario, field, value)
+    with pytest.raises(VicDrakeError, match=message):
+        run_scan(scenario, duration_s=0.1)
+    with pytest.raises(VicDrakeError, match=message):
+        MakeScanDiagram(scenario)
 
 
 @pytest.mark.slow

@@ -92,6 +92,10 @@ def test_partial_yaml_keeps_defaults_and_validates_nested_values():
             r"station\.sensor_period_s \(0\.08 s\)",
         ),
         (
+            "controller: {reference: {eps_d_m: 8}}",
+            r"eps_d_m is in metres and must be at most 0\.05 m; got 8\.0",
+        ),
+        (
             "variations: {sensor_faults: {stuck_channel: z}}",
             r"stuck_channel must be an int; got 'z'; allowed: -1 \(none\), 0 \(x\)",
         ),

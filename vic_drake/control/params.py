@@ -23,6 +23,7 @@ from vic_drake.paper import CONTACT_THRESHOLD_N, CONTROLLERS
 
 __all__ = [
     "CONTROLLERS",  # Re-exported from vic_drake.paper (its old home).
+    "MAX_PENETRATION_M",
     "SURFACE_VELOCITY_MODES",
     "ControllerParams",
     "ReferenceParams",
@@ -30,6 +31,10 @@ __all__ = [
     "TankParams",
     "real_controller_params",
 ]
+
+#: The largest penetration a reference may ask for (eps_max_m, eps_d_m), m:
+#: 5 cm, past any probe's use on soft tissue (the paper's are 8 mm).
+MAX_PENETRATION_M = 0.05
 
 #: Modes of the surface-velocity estimate used in the penetration rate.
 SURFACE_VELOCITY_MODES = ("moving_average", "gradient")
@@ -267,8 +272,13 @@ class ReferenceParams:
                 f"{o}.force_min_z_N must be < 0 (sensor convention, pressing); "
                 f"got {self.force_min_z_N!r}"
             )
-        _positive(o, "eps_max_m", self.eps_max_m)
-        _positive(o, "eps_d_m", self.eps_d_m)
+        for name in ("eps_max_m", "eps_d_m"):
+            value = _positive(o, name, getattr(self, name))
+            if value > MAX_PENETRATION_M:  # E.g. 8 (mm) typed for 0.008 (m).
+                raise VicDrakeError(
+                    f"{o}.{name} is in metres and must be at most "
+                    f"{MAX_PENETRATION_M:g} m; got {value!r} (0.008 is 8 mm)"
+                )
         if check_number(o, "contact_threshold_N", self.contact_threshold_N) < 0.0:
             raise VicDrakeError(
                 f"{o}.contact_threshold_N must be >= 0; got {self.contact_threshold_N!r}"

@@ -153,6 +153,7 @@ def MakeScanDiagram(
         raise VicDrakeError(
             f"MakeScanDiagram needs a Scenario; got {type(scenario).__name__}"
         )
+    scenario.validate()  # Fields set in code since it was made are checked too.
     if phantom is None:
         phantom = load_scenario_phantom(scenario, data_dir=data_dir)
     q0 = initial_joint_positions(scenario)

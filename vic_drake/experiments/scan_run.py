@@ -98,6 +98,11 @@ def run_scan(
     Returns:
         ScanResult with the canonical DataFrame, wall time and real-time factor.
     """
+    if not isinstance(scenario, Scenario):
+        raise VicDrakeError(f"run_scan needs a Scenario; got {type(scenario).__name__}")
+    # A scenario changed in code since it was loaded is checked again here
+    # (the loader checks a file's).
+    scenario.validate()
     duration = scenario.total_duration_s if duration_s is None else float(duration_s)
     if not duration > 0:
         raise VicDrakeError(f"duration_s must be > 0; got {duration_s!r}")
