@@ -43,6 +43,21 @@ def test_scan_window_is_the_target_at_scan_height_not_the_contact():
     assert not scan_window(never).any()
 
 
+def test_a_run_that_ends_in_its_approach_has_no_scan_window():
+    """Most of a short run's contact can be its approach: the scan height is
+    where the target is held, not the median target in contact."""
+    t = np.arange(0, 6, 0.002)
+    z_d = np.maximum(0.10 - 0.005 * t, 0.085)  # Held at the scan height from 3 s.
+    f = np.where(t < 0.5, 0.0, 5.0)  # Touches at 0.5 s, early in the approach.
+    w = scan_window(make_scan(t, f, z_d_m=z_d))
+    # From where the target is within 1 mm of its scan height (2.8 s).
+    assert t[w][0] == pytest.approx(2.8, abs=0.003) and t[w][-1] == t[-1]
+    # Cut at 2.5 s, in the approach: the median target in contact (at 1.5 s)
+    # is no scan height; there is no scan yet.
+    early = t < 2.5
+    assert not scan_window(make_scan(t[early], f[early], z_d_m=z_d[early])).any()
+
+
 def test_contact_loss_clipped_to_the_window_ends_there():
     t = np.arange(0, 12, 0.01)
     f = np.where(t < 1, 0.0, 7.0)

@@ -25,6 +25,11 @@ SETTLE_S = 1.0
 #: The target counts as "at scan height" within this of its scan height, m.
 SCAN_HEIGHT_TOL_M = 1e-3
 
+#: The target is held (not approaching or lifting) while its height changes
+#: slower than this, m/s: a tenth of a millimetre a second, against the
+#: approaches' 5-15 mm/s; the rig's targets are exactly constant in a scan.
+SCAN_HOLD_RATE_M_PER_S = 1e-4
+
 
 def pressing_force_N(df: pd.DataFrame) -> np.ndarray:
     """Pressing force, N (positive = pushing into the body)."""
@@ -43,24 +48,31 @@ def scan_window(df: pd.DataFrame, *, settle_s: float = SETTLE_S) -> np.ndarray:
     """Samples of the scan proper, as a boolean mask.
 
     The scan is where the target is held at its scan height: within
-    SCAN_HEIGHT_TOL_M of the median target height of the samples in contact,
-    from the first contact + ``settle_s`` until the target last leaves that
+    SCAN_HEIGHT_TOL_M of the median target height of the samples in contact
+    whose target is held (changing slower than SCAN_HOLD_RATE_M_PER_S: not
+    the approach, which a short run may spend most of its contact in), from
+    the first contact + ``settle_s`` until the target last leaves that
     height (the final lift). Contact losses inside the scan stay in the
     window: they are what a disturbance does to the scan. The approach and
     the final lift are out, whether or not the probe still touches then
     (CF cannot lift off, so "until the last contact" would score its
     retract as scanning).
 
-    Returns an all-False mask when the probe never touched.
+    Returns an all-False mask when the probe never touched, or when its
+    target was never held while in contact (a run that ends in its approach).
     """
     require_columns(df, "t_s", "z_d_m", "force_sensor_z_N")
     t = df["t_s"].to_numpy(float)
     z_d = df["z_d_m"].to_numpy(float)
     contact = contact_mask(df)
-    if not contact.any():
+    if len(df) < 2 or not contact.any():
         return np.zeros(len(df), bool)
     t_contact = t[np.argmax(contact)]
-    z_scan = np.nanmedian(z_d[contact])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        held = np.abs(np.gradient(z_d, t)) < SCAN_HOLD_RATE_M_PER_S
+    if not np.any(contact & held):  # Still approaching: no scan yet.
+        return np.zeros(len(df), bool)
+    z_scan = np.median(z_d[contact & held])
     at_height = np.abs(z_d - z_scan) < SCAN_HEIGHT_TOL_M
     if not at_height.any():
         return np.zeros(len(df), bool)
