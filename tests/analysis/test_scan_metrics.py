@@ -1,5 +1,7 @@
 """Scan metrics on records with known answers."""
 
+import math
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -51,3 +53,20 @@ def test_penetration_stats_split_ribs_from_soft_tissue():
     assert stats.rib_mean_m == pytest.approx(
         0.003
     ) and stats.soft_mean_m == pytest.approx(0.008)
+
+
+def test_the_log_says_which_controller_has_no_reference_or_tank():
+    """run_scan's logs carry their controller: CS has no force reference (its
+    logged 0 would score the pressing force) and CS and CF no tank (they log
+    its initial energy)."""
+    t = np.arange(0, 4, 0.002)
+    df = make_scan(t, np.where(t < 1, 0.0, 6.0))
+    df["force_ref_z_N"], df["tank_energy_J"] = 0.0, 0.5
+    assert force_rmse_N(df) == pytest.approx(6.0)  # No controller said.
+    assert tank_min_J(df) == 0.5
+    for controller, rmse_is_nan in (("cs", True), ("cf", False)):
+        df.attrs["controller"] = controller
+        assert math.isnan(force_rmse_N(df)) is rmse_is_nan
+        assert math.isnan(tank_min_J(df))
+        assert math.isnan(tank_min_J(df[t > 1.0]))  # A slice keeps it.
+        assert tank_min_J(df, has_tank=True) == 0.5  # The argument decides.

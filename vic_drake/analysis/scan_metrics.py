@@ -24,9 +24,13 @@ def force_rmse_N(df: pd.DataFrame, *, mask=None) -> float:
 
     The reference is ``force_ref_z_N``; samples where it is NaN are skipped,
     and so are the ticks the controller skipped on a non-finite reading
-    (``qp_fault`` = 1, where logged): their F_ref = 0 is no reference.
+    (``qp_fault`` = 1, where logged): their F_ref = 0 is no reference. NaN
+    for a CS log (``df.attrs["controller"]``, which ``run_scan`` sets): CS
+    has no force reference, and its logged 0 would score the pressing force.
     """
     require_columns(df, "force_sensor_z_N", "force_ref_z_N")
+    if df.attrs.get("controller") == "cs":
+        return float("nan")
     mask = scan_window(df) if mask is None else np.asarray(mask, bool)
     err = df["force_sensor_z_N"].to_numpy(float) - df["force_ref_z_N"].to_numpy(float)
     if "qp_fault" in df:
@@ -47,13 +51,17 @@ def peak_force_N(df: pd.DataFrame) -> float:
     return float(np.nanmax(pressing_force_N(df)))
 
 
-def tank_min_J(df: pd.DataFrame, *, has_tank: bool = True) -> float:
+def tank_min_J(df: pd.DataFrame, *, has_tank: bool | None = None) -> float:
     """Lowest tank energy of the run, J.
 
     NaN if the tank is not logged, or if the controller has none
     (``has_tank`` False: CS and CF, :func:`vic_drake.control.references.has_tank`;
-    their log holds the tank's initial energy throughout).
+    their log holds the tank's initial energy throughout). ``has_tank``
+    None: from the log's ``attrs["controller"]`` (``run_scan`` sets it),
+    True for a log without it.
     """
+    if has_tank is None:
+        has_tank = df.attrs.get("controller") not in ("cs", "cf")
     if not has_tank:
         return float("nan")
     require_columns(df, "tank_energy_J")

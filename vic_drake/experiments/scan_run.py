@@ -142,7 +142,13 @@ def run_scan(
     fdcc = diagram.GetSubsystemByName("fdcc")
     watch = fdcc.watchdog_state(fdcc.GetMyContextFromRoot(context))
     trip_s, channel = float(watch[TRIP_TIME]), int(watch[STUCK_CHANNEL])
-    df.attrs.update(source="sim", scenario=scenario.name)
+    # The controller travels with the log: CS has no force reference and
+    # neither CS nor CF a tank (scan_metrics reads it).
+    df.attrs.update(
+        source="sim",
+        scenario=scenario.name,
+        controller=scenario.controller.reference.controller,
+    )
     rig = rig_frame(logs, context)
     rig.attrs["beta"] = float(phantom.beta)
     return ScanResult(
