@@ -227,7 +227,8 @@ def nb_real_vs_sim():
             "# 4. Real logs against simulation\n\n"
             "The paper's scan logs (when the data is there) reduced to the same metrics "
             "as the simulated scans, and one real VS-VF scan replayed in simulation on "
-            "the measured map (`vic_drake.experiments.compare_real`)."
+            "the measured map (`vic_drake.experiments.compare_real`). It needs the "
+            "paper's data (without it, it says so and shows nothing)."
         ),
         new_code_cell(SETUP),
         new_code_cell(
@@ -239,13 +240,13 @@ from vic_drake.realdata import read_bag
 from vic_drake.reproduce import REAL_LIMITS, REAL_SCAN_LOGS, real_scan_frame
 
 if DATA is None:
-    print("no real data: set VIC_DRAKE_DATA or put it at ../shared/data")
-    real = {}
+    print("no real data: this notebook compares the paper's logs with simulation; "
+          "set VIC_DRAKE_DATA or put the data at ../shared/data")
 else:
     real = {key: real_scan_frame(read_bag(DATA / "experiments" / name), controller=key[1])
             for key, name in REAL_SCAN_LOGS.items()}
-pd.DataFrame({f"{c} ({cond})": scan_metrics(df, limits=REAL_LIMITS)
-              for (cond, c), df in real.items()}).T"""
+    display(pd.DataFrame({f"{c} ({cond})": scan_metrics(df, limits=REAL_LIMITS)
+                          for (cond, c), df in real.items()}).T)"""
         ),
         new_markdown_cell("## One real scan, simulated"),
         new_code_cell(
@@ -257,7 +258,12 @@ if DATA is not None:
     out, sim_df, real_df = compare_real(DATA / "experiments" / "test_nardi_matForce_lowR",
                                         duration_s=3.0 if SHORT else None,
                                         return_frames=True)
-    print({k: out[k] for k in ("controller", "force_rmse_N", "z_rmse_mm", "tank_min_J")})
+    # The figures are over window_s, the part of the log both runs cover.
+    print({k: out[k] for k in ("controller", "window_s", "force_rmse_N", "z_rmse_mm",
+                               "tank_min_J")})
+    if SHORT:
+        print("Short mode: 3 s simulated, so a window of a fraction of a second; "
+              "the README's figures are over the whole log.")
     display(plot_comparison(sim_df, real_df, title="VS-VF: simulated vs real"))"""
         ),
     ]
