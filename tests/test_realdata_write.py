@@ -37,6 +37,36 @@ def test_an_existing_bag_is_replaced(tmp_path):
     assert len(read_bag(tmp_path / "bag")) == 7
 
 
+def test_a_bag_it_did_not_write_is_never_replaced(tmp_path, data_dir):
+    """A real log (its metadata without vic_drake's mark) is refused, before
+    anything is deleted, by the writer and by the commands' early check."""
+    import shutil
+
+    real = tmp_path / "real"
+    shutil.copytree(data_dir / "experiments" / "test_tracking5", real)
+    before = sorted((p.name, p.stat().st_size) for p in real.iterdir())
+    for attempt in (
+        lambda: write_bag(_rows(CONTROLLER_COLUMNS), real),
+        lambda: check_bag_target(real),
+    ):
+        with pytest.raises(VicDrakeError, match="vic-drake did not write"):
+            attempt()
+    assert sorted((p.name, p.stat().st_size) for p in real.iterdir()) == before
+
+
+def test_a_bag_without_the_mark_is_never_replaced(tmp_path):
+    # The real data's logs are checked above where they are present; here a
+    # bag written by another tool: the same bag without vic_drake's mark.
+    bag = write_bag(_rows(SCAN_COLUMNS, n=20), tmp_path / "bag")
+    meta = bag / "metadata.yaml"
+    text = meta.read_text()
+    assert "written_by: vic_drake" in text
+    meta.write_text(text.replace("written_by: vic_drake", "written_by: ros2"))
+    with pytest.raises(VicDrakeError, match="vic-drake did not write"):
+        write_bag(_rows(SCAN_COLUMNS, n=7), bag)
+    assert len(read_bag(bag)) == 20
+
+
 def test_bad_rows_and_paths_are_clear_errors(tmp_path):
     with pytest.raises(VicDrakeError, match="layouts"):
         write_bag(pd.DataFrame({"t_s": [0.0], "a": [1.0]}), tmp_path / "x")

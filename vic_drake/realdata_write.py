@@ -35,6 +35,11 @@ _MSGTYPE = "std_msgs/msg/Float64MultiArray"
 _BAG_VERSION = 8
 
 
+#: The ``custom_data`` entry of the metadata of every bag :func:`write_bag`
+#: writes: only such a bag is replaced by another write (a real log never).
+WRITTEN_BY = ("written_by", "vic_drake")
+
+
 def _is_bag_folder(path: Path) -> bool:
     files = list(path.iterdir())
     return bool(files) and all(
@@ -42,12 +47,27 @@ def _is_bag_folder(path: Path) -> bool:
     )
 
 
+def _written_here(path: Path) -> bool:
+    """The bag folder's metadata carries :data:`WRITTEN_BY`."""
+    import yaml
+
+    try:
+        meta = yaml.safe_load((path / "metadata.yaml").read_text())
+        custom = meta["rosbag2_bagfile_information"].get("custom_data") or {}
+    except (OSError, yaml.YAMLError, KeyError, TypeError, AttributeError):
+        return False
+    key, value = WRITTEN_BY
+    return custom.get(key) == value
+
+
 def check_bag_target(path: str | os.PathLike, *, option: str = "--bag") -> Path:
     """Checks, before any work, that a bag can be written at ``path``.
 
     Allowed: a path that does not exist yet (its first existing parent must
-    be a writable folder), or an existing bag folder (metadata.yaml and .db3
-    files only), which :func:`write_bag` replaces.
+    be a writable folder), an empty folder, or a bag folder that
+    :func:`write_bag` wrote before (metadata.yaml and .db3 files only, with
+    :data:`WRITTEN_BY` in its metadata), which it replaces. Any other bag,
+    such as a real log, is never replaced.
 
     Raises:
         VicDrakeError: naming the option, the path and what is wrong.
@@ -61,6 +81,11 @@ def check_bag_target(path: str | os.PathLike, *, option: str = "--bag") -> Path:
             raise VicDrakeError(
                 f"{what} is a folder holding other files; expected a new folder or a "
                 "bag folder (metadata.yaml + .db3) to replace"
+            )
+        if any(path.iterdir()) and not _written_here(path):
+            raise VicDrakeError(
+                f"{what} holds a ROS 2 bag that vic-drake did not write (a real "
+                "log?); it is never replaced: choose a new folder"
             )
         if not os.access(path, os.W_OK):
             raise VicDrakeError(f"{what} is not writable")
@@ -133,6 +158,7 @@ def write_bag(
     stamps = np.round(t * 1e9).astype(np.int64)
     try:
         with Writer(path, version=_BAG_VERSION) as writer:
+            writer.set_custom_data(*WRITTEN_BY)
             conn = writer.add_connection(topic, _MSGTYPE, typestore=typestore)
             for stamp, row in zip(stamps.tolist(), data, strict=True):
                 msg = msg_cls(layout=empty_layout, data=row)
@@ -142,4 +168,4 @@ def write_bag(
     return path
 
 
-__all__ = ["LAYOUT_TOPICS", "check_bag_target", "write_bag"]
+__all__ = ["LAYOUT_TOPICS", "WRITTEN_BY", "check_bag_target", "write_bag"]
