@@ -351,6 +351,17 @@ def check_run_folder(out: Path, marker: str, *, others: str) -> bool:
     return own
 
 
+def check_not_a_run_folder(out: Path, option: str = "--out") -> None:
+    """Refuses a folder that holds a reproduce run or a campaign (their
+    marker files): a command that writes loose files never mixes them in."""
+    for marker, kind in _RUN_FOLDERS.items():
+        if (out / marker).is_file():
+            raise VicDrakeError(
+                f"{option} {str(out)!r} holds a vic-drake {kind} ({marker}); give "
+                "a new or empty folder"
+            )
+
+
 def _folder_contents(out: Path) -> str:
     """What a folder that is not the asked kind of run holds."""
     for marker, kind in _RUN_FOLDERS.items():

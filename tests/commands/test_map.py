@@ -52,13 +52,23 @@ def test_map_json_contract_and_outputs(tmp_path, capsys):
         (["--region", "0.1,0.0,-0.4,-0.3"], "--region"),
         (["--resolution-mm", "0.001"], "map grid would have"),
         (["--region=-0.09,-0.085,-0.37,-0.365"], "at least 4"),
+        (["--seed", "-5"], "--seed must be an integer >= 0; got -5"),
     ],
 )
 def test_bad_input_exits_2(tmp_path, capsys, args, message):
     status = main(["map", "--out", str(tmp_path / "o"), *args])
     assert status == 2
     err = capsys.readouterr().err
-    assert "vic-drake: error:" in err and message in err
+    assert "vic-drake: error:" in err and message in err and "Traceback" not in err
+    assert not (tmp_path / "o").exists()  # Refused before the folder is made.
+
+
+@pytest.mark.parametrize("marker", ["run.json", "spec.yaml"])
+def test_out_that_holds_another_run_exits_2(tmp_path, capsys, marker):
+    (tmp_path / marker).write_text("{}")
+    assert main(["map", "--out", str(tmp_path), *SMALL]) == 2
+    assert "holds a vic-drake" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == [marker]
 
 
 @pytest.mark.parametrize(

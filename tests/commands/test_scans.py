@@ -297,6 +297,9 @@ def test_compare_real_refuses_a_duration_short_of_the_contact_window(
     err = capsys.readouterr().err
     assert "duration 0.5 s ends before the real log's contact window" in err
     assert "simulate longer than 1.69 s" in err
+    for far in ("1e9", "40"):  # Past the 23.6 s log: nothing to compare there.
+        assert main(["compare-real", bag, "--duration", far]) == 2
+        assert "runs past the real log's end (23.6 s)" in capsys.readouterr().err
 
 
 @pytest.mark.realdata

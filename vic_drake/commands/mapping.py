@@ -29,7 +29,7 @@ from vic_drake.commands.common import (
 )
 from vic_drake.errors import VicDrakeError
 from vic_drake.experiments.dask_cluster import add_cluster_arguments
-from vic_drake.paths import check_output_dir
+from vic_drake.paths import check_not_a_run_folder, check_output_dir
 
 MAX_MAP_POINTS = 20_000_000  # 2001 x 1001 at 0.1 mm over 20 x 10 cm is 2 M.
 MAX_PALPATION_POINTS = 5_000
@@ -140,6 +140,7 @@ def _parse_region(text: str) -> tuple[float, float, float, float]:
 
 
 def _prepare_out(path: str) -> Path:
+    check_not_a_run_folder(Path(path).expanduser())
     return check_output_dir(path, "--out")
 
 
@@ -165,7 +166,8 @@ def run_map(args) -> int:
         raise VicDrakeError(
             f"--time-step-ms must be <= 2 (the sensor's 500 Hz period); got {args.time_step_ms!r}"
         )
-    out = _prepare_out(args.out)
+    if args.seed < 0:
+        raise VicDrakeError(f"--seed must be an integer >= 0; got {args.seed}")
     phantom = load_phantom(args.phantom, data_dir=args.data_dir)
     region = _parse_region(args.region) if args.region else default_region(phantom)
     n_map = (int((region[1] - region[0]) / resolution_m + 1e-6) + 1) * (
@@ -187,6 +189,7 @@ def run_map(args) -> int:
             f"only {n_points} palpation points fit in the region at --spacing-cm "
             f"{args.spacing_cm:g}; a map needs at least 4"
         )
+    out = _prepare_out(args.out)  # Made once the options are known to be good.
 
     mapped = run_map_pipeline(
         phantom,

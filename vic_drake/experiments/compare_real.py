@@ -89,17 +89,24 @@ def phantom_replay(bag: Path, real, phantom):
 def check_duration_reaches_window(real, duration_s: float | None) -> None:
     """Refuses, before simulating, a duration that ends before the real log's
     contact window (where the comparison is made: first contact + 1 s until
-    the final lift, :func:`~vic_drake.analysis.contact.scan_window`).
+    the final lift, :func:`~vic_drake.analysis.contact.scan_window`), or more
+    than a second past the log's end.
 
     Raises:
         VicDrakeError: naming the window and the log's length.
     """
     if duration_s is None:
         return
+    t = real["t_s"].to_numpy(float)
+    if duration_s > float(t[-1]) + 1.0:  # Past the log there is nothing to compare.
+        raise VicDrakeError(
+            f"duration {duration_s:g} s runs past the real log's end "
+            f"({float(t[-1]):.1f} s), where there is nothing to compare; give at "
+            f"most {float(t[-1]) + 1.0:.1f} s, or leave it out for the whole log"
+        )
     window = scan_window(real)
     if not window.any():
         return  # compare_with_real names a log without a window.
-    t = real["t_s"].to_numpy(float)
     start, end = float(t[window][0]), float(t[window][-1])
     if duration_s <= start:
         raise VicDrakeError(
