@@ -83,3 +83,26 @@ def test_full_vs_vf_nominal_scan_tracks_and_lifts_off():
     assert metrics.lifted_off(df)
     assert metrics.tank_min_J(df) >= 0.4 - 1e-6
     assert metrics.peak_force_N(df) < 15.0
+
+
+def test_the_phantom_starts_at_rest_where_its_motion_starts():
+    """A lift that starts off zero (a real log's replayed motion) is where the
+    phantom starts, at rest: it is not driven up into the probe at t = 0."""
+    from vic_drake.scenario import DisturbanceConfig
+
+    scenario = synthetic_scenario("cs")
+    scenario.disturbance = DisturbanceConfig(table=[[0.0, 0.004], [1.0, 0.004]])
+    df = run_scan(scenario, duration_s=0.05).df
+    np.testing.assert_allclose(df["phantom_lift_m"], 0.004, atol=1e-7)
+
+
+@pytest.mark.realdata
+def test_a_disturbed_real_logs_scenario_starts_without_an_impact(data_dir):
+    """diagrams/real_test_force_control_dist.yaml starts in contact with its
+    phantom lifted 6.1 mm; the log starts at 5.7 N. With the phantom started
+    at zero lift its servo drove it into the probe: 21.8 N at 6 ms."""
+    from vic_drake.experiments import load_diagram
+
+    scenario = load_diagram("real_test_force_control_dist")
+    df = run_scan(scenario, duration_s=0.5, data_dir=data_dir).df
+    assert df["force_sensor_z_N"].abs().max() < 8.0

@@ -285,15 +285,23 @@ def initial_joint_positions(scenario: Scenario) -> np.ndarray:
 
 
 def set_initial_state(diagram, root_context, q0) -> None:
-    """Starts the arm at rest at q0 and every joint-command state at q0.
+    """Starts the arm at rest at q0 and every joint-command state at q0, and
+    the phantom at rest where its motion starts.
 
     Sets the station's state (``station.set_station_state``: plant at q0,
-    phantom at zero lift, the joint servo's state) and the FDCC's command
-    state, so the first commanded motion is zero, not a jump from zero angles.
+    the joint servo's state; the phantom's joints at their commands at t = 0,
+    and their servo's state there) and the FDCC's command state, so the
+    first commanded motion is zero, not a jump from zero angles, and a
+    motion that starts off zero (a real log's replayed lift) does not drive
+    the phantom into the probe in the first milliseconds.
     """
     station = diagram.GetSubsystemByName("station")
     station_context = station.GetMyMutableContextFromRoot(root_context)
-    set_station_state(station, station_context, q0)
+    servo = station.GetSubsystemByName("phantom_lift_interpolator")
+    servo_context = servo.GetMyMutableContextFromRoot(root_context)
+    command = servo.get_input_port().Eval(servo_context)  # [lift(, x, y)], t = 0
+    set_station_state(station, station_context, q0, phantom_command=command)
+    servo.set_initial_position(servo_context, command)
     fdcc = diagram.GetSubsystemByName("fdcc")
     fdcc.set_initial_command(fdcc.GetMyMutableContextFromRoot(root_context), q0)
 
