@@ -1,5 +1,6 @@
 """The reproduce pipeline end to end: stages, outputs, claims, report."""
 
+import html
 import json
 
 import pytest
@@ -60,3 +61,22 @@ def test_reproduce_quick_end_to_end(tmp_path):
     assert "palpation_sim_hc_2.5hz.parquet" in parquet
     for n in parquet:  # every log has its configuration beside it
         assert n.replace(".parquet", ".yaml") in logs
+
+
+@pytest.mark.parametrize("phantom", ["synthetic", "measured"])
+def test_the_report_says_what_the_synthetic_chest_is(tmp_path, phantom, request):
+    """The synthetic chest is fitted to the measured map: the report says so,
+    as what it is (the map's ribs are in it by construction)."""
+    data_dir = request.getfixturevalue("data_dir") if phantom == "measured" else None
+    result = reproduce(
+        ReproduceOptions(
+            out_dir=tmp_path,
+            data_dir=data_dir,
+            phantom=phantom,
+            stages=("claims", "report"),
+        )
+    )
+    text = html.unescape(result.report_path.read_text())
+    assert f"Phantom for the simulated scans: {phantom}" in text
+    twin = "the measured phantom's twin: its surface, its ribs and its kappa"
+    assert (twin in text) == (phantom == "synthetic")

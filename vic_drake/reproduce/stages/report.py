@@ -193,8 +193,16 @@ def stage_report(ctx: RunContext) -> dict:
         title="vic_drake: reproduction of Beber et al., passive variable impedance "
         "control for safe ultrasonography",
         summary=(
-            f"Mode: {mode}. Phantom for the simulated scans: {ctx.phantom_kind}. "
-            f"Real data: {ctx.data_dir if ctx.data_dir else 'not found'}. Each claim is a "
+            f"Mode: {mode}. Phantom for the simulated scans: {ctx.phantom_kind}"
+            + (
+                " (the measured phantom's twin: its surface, its ribs and its kappa "
+                "and lambda are fitted to the paper's measured map, so the map's "
+                "ribs of C3 are in it by construction; the controllers' behaviour "
+                "on it is simulated). "
+                if ctx.phantom_kind == "synthetic"
+                else ". "
+            )
+            + f"Real data: {ctx.data_dir if ctx.data_dir else 'not found'}. Each claim is a "
             "metric computed from logged signals, in simulation and in the paper's real "
             "logs where they exist."
         ),
