@@ -92,6 +92,17 @@ def test_replay_qp_command_json(data_dir, capsys):
     assert record["solver"] == "exact" and record["kz_abs_err_max"] <= 1e-3
 
 
+def test_replay_qp_reads_r_off_the_log_by_default(data_dir, capsys):
+    # The VS-VF session ran with R = 1e-5: the old default 0.1 gave K_z
+    # errors of 14 N/m median, 313 N/m max, and exit 0.
+    bag = data_dir / "experiments" / "test_nardi_matForce_lowR"
+    assert main(["replay-qp", str(bag), "--solver", "exact"]) == 0
+    out = capsys.readouterr().out
+    assert "(R = 1e-05, read off the log's K_z; solver exact)" in out
+    assert main(["replay-qp", str(bag), "--solver", "exact", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["kz_abs_err_max"] <= 1e-3
+
+
 def test_replay_qp_command_errors(data_dir, capsys):
     assert (
         main(["replay-qp", str(data_dir / "experiments" / "test_force_control")]) == 2

@@ -26,8 +26,9 @@ def register(subparsers) -> None:
             "velocity error, F_ref, F_min, the tank energy before the tick, the previous "
             "stiffness for the damping, dt from the timestamps) through the same QP and "
             "tank, and reports how closely K_z and the tank energy match the log. R is "
-            "not logged: pass --R (0.1 for test_tracking5, 1e-5 for "
-            "test_nardi_matForce_lowR); the default is 0.1."
+            "not logged: by default it is read off the log's K_z (the ticks where no "
+            "bound or row is active give it in closed form; 0.1 for test_tracking5, "
+            "1e-5 for test_nardi_matForce_lowR), or give it with --R."
         ),
     )
     parser.add_argument(
@@ -40,9 +41,10 @@ def register(subparsers) -> None:
         "--R",
         dest="r_weight",
         type=float,
-        default=0.1,
+        default=None,
         metavar="R",
-        help="stiffness regularisation weight R on every axis (> 0; default 0.1)",
+        help="stiffness regularisation weight R on every axis (> 0; default: read "
+        "off the log's K_z)",
     )
     parser.add_argument(
         "--solver",
@@ -82,7 +84,7 @@ def run_replay_qp(args: argparse.Namespace) -> int:
     from vic_drake.control.replay import replay_bag
 
     r = args.r_weight
-    if not (math.isfinite(r) and r > 0.0):
+    if r is not None and not (math.isfinite(r) and r > 0.0):
         raise VicDrakeError(f"--R must be a finite number > 0; got {r!r}")
     bag = bag_path(
         args,
@@ -90,11 +92,21 @@ def run_replay_qp(args: argparse.Namespace) -> int:
         expected="a ROS 2 bag folder (metadata.yaml + .db3) of a 31-column "
         "variable-impedance log",
     )
+    source = "--R"
+    if r is None:  # A wrong R gives K_z errors of hundreds of N/m: read it.
+        from vic_drake.analysis.r_weight_id import identify_r_weight
+        from vic_drake.realdata import read_bag
+
+        r, source = (
+            identify_r_weight(read_bag(bag, expect="controller"))["r_weight"],
+            "read off the log's K_z",
+        )
     with native_stdout_to_stderr():
         result = replay_bag(bag, r_weight=r, solver=args.solver)
+    # The --json record keeps its keys (a contract); the text names R.
     summary = result.summary()
     human = (
-        f"replay-qp {args.bag_dir} (R = {r:g}, solver {summary['solver']}): "
+        f"replay-qp {args.bag_dir} (R = {r:g}, {source}; solver {summary['solver']}): "
         f"{summary['ticks']} ticks, |K_z error| median {summary['kz_abs_err_median']:.3g}, "
         f"p99 {summary['kz_abs_err_p99']:.3g}, max {summary['kz_abs_err_max']:.3g} N/m; "
         f"tank |error| max {summary['tank_abs_err_max_J']:.3g} J; "
