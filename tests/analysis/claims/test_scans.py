@@ -62,6 +62,13 @@ def test_c4_and_c5_thresholds():
     assert not C.claim_c4(
         {"vs-cf": {**vscf, "lifted_off": False}, "cf": cf}, None
     ).passed
+    # A CF run that never asked for a lift (the rig's logs end at the scan
+    # height) does not test "CF cannot lift off": untested, not evidence.
+    untested = {**cf, "lift_commanded": False}
+    claim = C.claim_c4(None, {"vs-cf": vscf, "cf": untested})
+    assert claim.pass_real and claim.real["cf_lifted_off"] is None
+    still = C.claim_c4(None, {"vs-cf": {**vscf, "lifted_off": False}, "cf": untested})
+    assert not still.pass_real  # VS-CF's lift was asked for and did not happen.
     assert C.claim_c5({"cs": cs, "vs-cf": vscf}, None).passed
     assert not C.claim_c5({"cs": {"force_range_N": 1.9}, "vs-cf": vscf}, None).passed
     assert not C.claim_c5({"cs": cs}, None).passed  # VS-CF missing: not evaluated

@@ -17,6 +17,7 @@ from vic_drake.analysis.claims.thresholds import (
 )
 from vic_drake.analysis.contact import (
     CONTACT_THRESHOLD_N,
+    SCAN_HEIGHT_TOL_M,
     SETTLE_S,
     contact_loss_intervals,
     pressing_force_N,
@@ -90,7 +91,8 @@ def scan_metrics(
         window; only when the reference is nonzero there), force_range_N
         (98th - 2nd percentile of the pressing force in the window),
         peak_force_N (whole run), lifted_off (mean pressing force of the
-        last end_s below the contact threshold), and where the columns
+        last end_s below the contact threshold), lift_commanded (the target
+        ends above its scan height; only with a scan window), and where the columns
         exist: penetration / force-cap metrics (C6), contact-loss, stiffness
         and tank metrics (C7; the tank's NaN for a controller without one,
         ``limits.has_tank`` False).
@@ -112,6 +114,12 @@ def scan_metrics(
     end = t >= t[-1] - end_s
     out["final_force_N"] = float(np.mean(f[end]))
     out["lifted_off"] = bool(out["final_force_N"] < CONTACT_THRESHOLD_N)
+    if w.any():
+        # Whether the run asked for a lift at its end (the target leaves its
+        # scan height): the rig's CS and CF logs end at the scan height, so
+        # their staying in contact says nothing about lifting off.
+        z_d = df["z_d_m"].to_numpy(float)
+        out["lift_commanded"] = bool(z_d[-1] > np.median(z_d[w]) + SCAN_HEIGHT_TOL_M)
     if w.sum() >= 10:
         fw = f[w]
         lo, hi = np.percentile(fw, [2, 98])
