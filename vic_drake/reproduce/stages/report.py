@@ -61,7 +61,10 @@ def report_notes(ctx: RunContext, claims: dict) -> list[str]:
     if ctx.options.quick:
         notes.append(
             "Quick mode scans 5 cm instead of 20 cm with one disturbance event; force "
-            "ranges (C5) and peak forces (C7) see less of the body than the full run."
+            "ranges (C5) and peak forces (C7) see less of the body than the full run, "
+            "and that one event can put CF's peak above CS's, where the real logs "
+            "(and the full run on the measured map, README) have CS's above CF's; "
+            "C7 compares VS-VF with both."
         )
     return notes
 
