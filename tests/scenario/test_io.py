@@ -149,3 +149,11 @@ def test_another_kind_of_vic_drake_yaml_is_named(tmp_path):
     # A scenario with a misspelt field still gets the field error.
     with pytest.raises(VicDrakeError, match="duraton_s is unknown"):
         loads_scenario("duraton_s: 3\n")
+
+
+def test_a_bare_name_points_to_load_diagram(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(
+        VicDrakeError, match=r"use vic_drake\.experiments\.load_diagram"
+    ):
+        load_scenario("nominal_vs_vf_synthetic")

@@ -43,6 +43,18 @@ def load_scenario(path: str | os.PathLike) -> Scenario:
     Raises:
         VicDrakeError: naming the file and the offending field and value.
     """
+    if (
+        isinstance(path, str)
+        and not path.endswith((".yaml", ".yml"))
+        and not (Path(path).exists())
+    ):
+        # A bare name such as "nominal_vs_vf_synthetic": the CLI takes it for
+        # diagrams/NAME.yaml; from Python that is load_diagram's job.
+        raise VicDrakeError(
+            f"scenario file {path!r} does not exist; for a shipped scenario by "
+            "name use vic_drake.experiments.load_diagram(name), or give the "
+            "file's path (diagrams/NAME.yaml)"
+        )
     path = check_input_file(path, "scenario file")
     return _load({"filename": str(path)}, f"scenario file {str(path)!r}")
 
