@@ -286,6 +286,10 @@ def test_compare_real_refuses_settings_the_controller_does_not_have(
     assert main(["compare-real", bag, "--controller", "cs", "--force", "7"]) == 2
     err = capsys.readouterr().err
     assert "--force applies to CF and VS-CF, not to the given controller cs" in err
+    # Only the VS controllers wrote 31-column logs.
+    assert main(["compare-real", bag, "--controller", "cs"]) == 2
+    err = capsys.readouterr().err
+    assert "--controller must be vs-cf or vs-vf, got 'cs'" in err
 
 
 @pytest.mark.realdata

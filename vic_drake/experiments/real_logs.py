@@ -218,6 +218,11 @@ def identify_real_log(
         )
         return found
     check_settings_apply(controller, True, stiffness_N_per_m, force_N, r_weight)
+    if layout == "controller" and controller in ("cs", "cf"):
+        raise VicDrakeError(
+            "a 31-column log is a variable-impedance scan (only the VS controllers "
+            f"logged it); --controller must be vs-cf or vs-vf, got {controller!r}"
+        )
     setting = {"cs": stiffness_N_per_m, "cf": force_N}.get(controller)
     if layout == "scan" and setting is not None:
         return ControllerIdentification(controller, given=True)
