@@ -81,7 +81,8 @@ def native_stdout_to_stderr():
 
 
 def run_replay_qp(args: argparse.Namespace) -> int:
-    from vic_drake.control.replay import replay_bag
+    from vic_drake.control.replay import replay_controller_log
+    from vic_drake.realdata import read_bag
 
     r = args.r_weight
     if r is not None and not (math.isfinite(r) and r > 0.0):
@@ -92,17 +93,14 @@ def run_replay_qp(args: argparse.Namespace) -> int:
         expected="a ROS 2 bag folder (metadata.yaml + .db3) of a 31-column "
         "variable-impedance log",
     )
+    log = read_bag(bag, expect="controller")  # Read once: for R and the replay.
     source = "--R"
     if r is None:  # A wrong R gives K_z errors of hundreds of N/m: read it.
         from vic_drake.analysis.r_weight_id import identify_r_weight
-        from vic_drake.realdata import read_bag
 
-        r, source = (
-            identify_r_weight(read_bag(bag, expect="controller"))["r_weight"],
-            "read off the log's K_z",
-        )
+        r, source = identify_r_weight(log)["r_weight"], "read off the log's K_z"
     with native_stdout_to_stderr():
-        result = replay_bag(bag, r_weight=r, solver=args.solver)
+        result = replay_controller_log(log, r_weight=r, solver=args.solver)
     # The --json record keeps its keys (a contract); the text names R.
     summary = result.summary()
     human = (

@@ -236,19 +236,12 @@ def station_plant(station: Diagram) -> MultibodyPlant:
     return station.GetSubsystemByName("plant")
 
 
-def set_station_state(
-    station: Diagram,
-    station_context,
-    q,
-    *,
-    phantom_lift_m: float = 0.0,
-    phantom_command=None,
-):
-    """Sets the arm at rest at q (6,) and the phantom at a lift, in a station context.
+def set_station_state(station: Diagram, station_context, q, *, phantom_command=(0.0,)):
+    """Sets the arm at rest at q (6,) and the phantom at rest, in a station context.
 
-    The phantom is at rest, at zero lateral offset if it has lateral joints;
-    or, with ``phantom_command`` ([lift] or [lift, x, y], m: its servo's
-    command), where that command puts it.
+    ``phantom_command``: where the phantom's joints are, m, in its servo's
+    command order: [lift] or [lift, x, y] (lateral joints not given stay
+    at zero).
     """
     plant = station_plant(station)
     plant_context = station.GetMutableSubsystemContext(plant, station_context)
@@ -263,8 +256,7 @@ def set_station_state(
     n = plant.num_positions(phantom)  # 1, or 3 with the lateral joints
     plant.SetPositions(plant_context, phantom, np.zeros(n))
     plant.SetVelocities(plant_context, phantom, np.zeros(n))
-    command = [phantom_lift_m] if phantom_command is None else list(phantom_command)
-    for name, value in zip(("phantom_lift", "phantom_x", "phantom_y"), command):
+    for name, value in zip(("phantom_lift", "phantom_x", "phantom_y"), phantom_command):
         plant.GetJointByName(name, phantom).set_translation(plant_context, value)
 
 

@@ -30,6 +30,7 @@ from vic_drake.experiments.campaign.spec import CampaignSpec
 from vic_drake.experiments.campaign.stats import (
     MIN_EFFECT_RUNS,
     factor_effects,
+    touched,
     worst_runs,
 )
 from vic_drake.paper import CONTACT_THRESHOLD_N
@@ -82,7 +83,7 @@ def distribution_figure(rows: pd.DataFrame, force_limit_N: float):
         for n in names:
             v = ok.loc[ok["factor.controller"] == n, col].dropna().to_numpy(float)
             if col == "peak_force_N":  # A run that never touched has no peak
-                v = v[v > CONTACT_THRESHOLD_N]  # (the table counts them).
+                v = v[touched(v)]  # (the table counts them).
             data.append(v)
         if names:
             ax.boxplot(data, showfliers=True)
@@ -391,11 +392,14 @@ def summary_html(
     if not rows.empty:
         parts.append(_png(distribution_figure(rows, spec.force_limit_N)))
         scored = rows[rows["status"] != "error"]
-        touched = scored[scored["peak_force_N"] > CONTACT_THRESHOLD_N]
-        untouched = int((scored["peak_force_N"] <= CONTACT_THRESHOLD_N).sum())
-        text, numeric = _effects_html(touched, untouched)
+        peaks = scored["peak_force_N"].to_numpy(float)
+        in_contact = touched(peaks)
+        untouched = int(np.sum(np.isfinite(peaks) & ~in_contact))
+        text, numeric = _effects_html(scored[in_contact], untouched)
         parts.append(text)
-        parts.extend(_png(effect_figure(touched, factor)) for factor in numeric)
+        parts.extend(
+            _png(effect_figure(scored[in_contact], factor)) for factor in numeric
+        )
         parts.append(_worst_html(out, rows))
     style = (
         "<style>table{border-collapse:collapse}"

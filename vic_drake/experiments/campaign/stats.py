@@ -47,6 +47,12 @@ def _stat(values, fn) -> float:
     return float(fn(v)) if v.size else math.nan
 
 
+def touched(peak_force_N) -> np.ndarray:
+    """Which runs touched the patient: a peak tissue force above
+    :data:`~vic_drake.paper.CONTACT_THRESHOLD_N` (False for NaN)."""
+    return np.asarray(peak_force_N, float) > CONTACT_THRESHOLD_N
+
+
 def _count_finite(rows: pd.DataFrame, column: str) -> int:
     """Rows with a finite ``column`` (0 for rows written before it existed)."""
     if column not in rows:
@@ -74,7 +80,7 @@ def per_controller(rows: pd.DataFrame, force_limit_N: float) -> dict:
     for name, group in rows.groupby("factor.controller", sort=True):
         scored = group[group["status"] != "error"]
         peaks = _finite(scored["peak_force_N"])
-        touched = peaks > CONTACT_THRESHOLD_N
+        in_contact = touched(peaks)
         exceed = int(np.sum(peaks > force_limit_N))
         lo, hi = wilson_interval(exceed, peaks.size)
         out[str(name)] = {
@@ -86,8 +92,8 @@ def per_controller(rows: pd.DataFrame, force_limit_N: float) -> dict:
             "contact_loss_s_p50": _stat(scored["contact_loss_s"], np.median),
             "tank_min_J": _stat(scored["tank_min_J"], np.min),
             "watchdog_stops": _count_finite(scored, "watchdog_trip_s"),
-            "no_contact_runs": int(np.sum(~touched)),
-            "peak_force_N_p50_contact": _stat(peaks[touched], np.median),
+            "no_contact_runs": int(np.sum(~in_contact)),
+            "peak_force_N_p50_contact": _stat(peaks[in_contact], np.median),
         }
     return out
 
@@ -233,6 +239,7 @@ __all__ = [
     "factor_effects",
     "paired_arms",
     "per_controller",
+    "touched",
     "wilson_interval",
     "worst_runs",
 ]

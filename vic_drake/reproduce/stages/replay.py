@@ -143,7 +143,9 @@ def replay_scan(
     )
     for i, tf in zip(idx, frames):
         context.SetTime(float(tf))
-        set_station_state(station, station_context, q[i], phantom_lift_m=float(lift[i]))
+        set_station_state(
+            station, station_context, q[i], phantom_command=[float(lift[i])]
+        )
         diagram.ForcedPublish(context)
     meshcat.StopRecording()
     meshcat.PublishRecording()
