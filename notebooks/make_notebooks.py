@@ -76,7 +76,7 @@ print(f"{data.n} samples over {data.duration_s:.1f} s")"""
             """\
 from vic_drake.reproduce.plots.offline import plot_table_i
 
-comparison = compare_models(data, (1.1, 1.35, 1.5), lag_s=lag, sweep=not SHORT)
+comparison = compare_models(data, (1.5, 1.35, 1.1), lag_s=lag, sweep=not SHORT)
 print(f"lag {comparison.lag_s * 1e3:.1f} ms")
 print(f"Kelvin-Voigt: {comparison.kelvin_voigt.relative:.4f}")
 for beta, fit in comparison.hunt_crossley.items():

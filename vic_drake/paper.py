@@ -16,15 +16,15 @@ CONTROLLERS = ("cs", "cf", "vs-cf", "vs-vf")
 #: The controllers the paper runs under the disturbance (Fig. 7).
 DISTURBANCE_CONTROLLERS = ("vs-vf", "cs", "cf")
 
-#: The Hunt-Crossley exponents of Table I.
-TABLE_I_BETAS = (1.1, 1.35, 1.5)
+#: The Hunt-Crossley exponents of Table I, in its column order.
+TABLE_I_BETAS = (1.5, 1.35, 1.1)
 
 #: The exponent the paper found best (Table I) and used for its maps.
 BEST_BETA = 1.35
 
 #: Table I: relative fit residual of Kelvin-Voigt and of Hunt-Crossley per beta.
 PAPER_TABLE_I_KELVIN_VOIGT = 0.066
-PAPER_TABLE_I_HUNT_CROSSLEY = {1.1: 0.045, 1.35: 0.014, 1.5: 0.029}
+PAPER_TABLE_I_HUNT_CROSSLEY = {1.5: 0.029, 1.35: 0.014, 1.1: 0.045}
 
 #: Contact: pressing force above this, N. The real controller declared contact
 #: when the sensor's z force was below -0.5 N (data README), about five times

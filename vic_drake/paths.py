@@ -351,22 +351,29 @@ def check_run_folder(out: Path, marker: str, *, others: str) -> bool:
     return own
 
 
+def _run_folder_kind(out: Path) -> str | None:
+    """ "a vic-drake <kind> (<marker>)" if ``out`` holds a run's marker, else None."""
+    for marker, kind in _RUN_FOLDERS.items():
+        if (out / marker).is_file():
+            return f"a vic-drake {kind} ({marker})"
+    return None
+
+
 def check_not_a_run_folder(out: Path, option: str = "--out") -> None:
     """Refuses a folder that holds a reproduce run or a campaign (their
     marker files): a command that writes loose files never mixes them in."""
-    for marker, kind in _RUN_FOLDERS.items():
-        if (out / marker).is_file():
-            raise VicDrakeError(
-                f"{option} {str(out)!r} holds a vic-drake {kind} ({marker}); give "
-                "a new or empty folder"
-            )
+    kind = _run_folder_kind(out)
+    if kind is not None:
+        raise VicDrakeError(
+            f"{option} {str(out)!r} holds {kind}; give a new or empty folder"
+        )
 
 
 def _folder_contents(out: Path) -> str:
     """What a folder that is not the asked kind of run holds."""
-    for marker, kind in _RUN_FOLDERS.items():
-        if (out / marker).is_file():
-            return f"a vic-drake {kind} ({marker})"
+    kind = _run_folder_kind(out)
+    if kind is not None:
+        return kind
     names = sorted(p.name + ("/" if p.is_dir() else "") for p in out.iterdir())
     shown = ", ".join(names[:4]) + (", ..." if len(names) > 4 else "")
     return f"other files ({shown})"

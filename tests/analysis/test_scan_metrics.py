@@ -58,11 +58,14 @@ def test_penetration_stats_split_ribs_from_soft_tissue():
 def test_the_log_says_which_controller_has_no_reference_or_tank():
     """run_scan's logs carry their controller: CS has no force reference (its
     logged 0 would score the pressing force) and CS and CF no tank (they log
-    its initial energy)."""
+    its initial energy). A log that does not say (a rig log) and holds a zero
+    reference over the window has none either."""
     t = np.arange(0, 4, 0.002)
     df = make_scan(t, np.where(t < 1, 0.0, 6.0))
     df["force_ref_z_N"], df["tank_energy_J"] = 0.0, 0.5
-    assert force_rmse_N(df) == pytest.approx(6.0)  # No controller said.
+    assert math.isnan(force_rmse_N(df))  # No controller said; the reference is 0.
+    df["force_ref_z_N"] = -5.0
+    assert force_rmse_N(df) == pytest.approx(1.0)
     assert tank_min_J(df) == 0.5
     for controller, rmse_is_nan in (("cs", True), ("cf", False)):
         df.attrs["controller"] = controller

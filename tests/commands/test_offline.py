@@ -253,3 +253,18 @@ def test_load_test_refuses_swapped_logs(capsys, data_dir):
     status, _, err = run(capsys, ["load-test", load, "--fit-from", load])
     assert status == 2
     assert f"--fit-from {str(load)!r} is a load/unload test, not a palpation" in err
+
+
+def test_table_i_columns_come_in_the_papers_order():
+    """Kelvin-Voigt, then beta 1.5, 1.35, 1.1, as the paper's Table I: in
+    fit-palpation's default, the report's table and figure, and the claims."""
+    from vic_drake.analysis.claims import ModelResiduals
+    from vic_drake.cli import build_parser
+    from vic_drake.paper import paper_table_i
+
+    args = build_parser().parse_args(["fit-palpation", "bag"])
+    assert args.betas == "1.5,1.35,1.1"
+    order = ["kelvin_voigt", "hc_1.5", "hc_1.35", "hc_1.1"]
+    assert list(paper_table_i()) == order
+    residuals = ModelResiduals(0.066, {1.1: 0.045, 1.35: 0.014, 1.5: 0.029})
+    assert list(residuals.as_dict()) == order

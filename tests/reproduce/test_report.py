@@ -16,7 +16,7 @@ from vic_drake.reproduce.report import (  # noqa: E402
     render_report,
     write_report,
 )
-from vic_drake.reproduce.stages.claims import _TABLE_KEYS
+from vic_drake.reproduce.stages.claims import _TABLE_COLUMNS
 
 
 def _content():
@@ -99,7 +99,7 @@ def test_render_without_claims():
 def _wide_content():
     """A report like a run's: the 12-column scan-metrics table, long claims."""
     content = _content()
-    keys = list(_TABLE_KEYS)
+    keys = [name for _, name, _ in _TABLE_COLUMNS]
     rows = [
         ["disturbance", c, *(123.456789 * (i + 1) for i in range(len(keys)))]
         for c in ("cs", "cf", "vs-cf", "vs-vf")

@@ -25,16 +25,20 @@ def force_rmse_N(df: pd.DataFrame, *, mask=None) -> float:
     The reference is ``force_ref_z_N``; samples where it is NaN are skipped,
     and so are the ticks the controller skipped on a non-finite reading
     (``qp_fault`` = 1, where logged): their F_ref = 0 is no reference. NaN
-    for a CS log (``df.attrs["controller"]``, which ``run_scan`` sets): CS
-    has no force reference, and its logged 0 would score the pressing force.
+    where there is no force reference: a CS log (``df.attrs["controller"]``,
+    which ``run_scan`` sets), or a reference that is zero over the whole mask
+    (CS logs a 0, which would score the pressing force).
     """
     require_columns(df, "force_sensor_z_N", "force_ref_z_N")
     if df.attrs.get("controller") == "cs":
         return float("nan")
     mask = scan_window(df) if mask is None else np.asarray(mask, bool)
-    err = df["force_sensor_z_N"].to_numpy(float) - df["force_ref_z_N"].to_numpy(float)
+    ref = df["force_ref_z_N"].to_numpy(float)
     if "qp_fault" in df:
         mask = mask & ~(df["qp_fault"].to_numpy(float) > 0.5)
+    if not np.any(np.abs(ref[mask]) > 0):
+        return float("nan")
+    err = df["force_sensor_z_N"].to_numpy(float) - ref
     err = err[mask & np.isfinite(err)]
     return float(np.sqrt(np.mean(err**2))) if err.size else float("nan")
 

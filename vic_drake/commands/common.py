@@ -102,7 +102,7 @@ def parse_float_list(text: str, option: str) -> list[float]:
         values = [float(v) for v in text.split(",") if v.strip()]
     except ValueError:
         raise VicDrakeError(
-            f"{option} takes comma-separated numbers like 1.1,1.35,1.5; got {text!r}"
+            f"{option} takes comma-separated numbers like 1.5,1.35,1.1; got {text!r}"
         ) from None
     if not values:
         raise VicDrakeError(f"{option} needs at least one number; got {text!r}")

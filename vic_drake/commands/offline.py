@@ -31,6 +31,7 @@ from vic_drake.commands.common import (
     parse_float_list,
 )
 from vic_drake.errors import VicDrakeError
+from vic_drake.paper import TABLE_I_BETAS
 from vic_drake.paths import PLOT_SUFFIXES, check_output_file
 
 _RELATIVE_HELP = (
@@ -269,7 +270,7 @@ def register(subparsers) -> None:
     )
     p.add_argument(
         "--betas",
-        default="1.1,1.35,1.5",
+        default=",".join(f"{b:g}" for b in TABLE_I_BETAS),
         metavar="B1,B2,...",
         help="Hunt-Crossley exponents to report, each in (0, 3] (default %(default)s)",
     )

@@ -253,29 +253,58 @@ def online_comparison(
     return out
 
 
-#: The table's scores: (key, column title, decimals).
+#: The table's scores: (key, column title, decimals, what it is). All are
+#: over the scan window.
 _COLUMNS = (
-    ("force_rmse_true_N", "force RMSE vs truth N", 3),
-    ("force_rmse_dithered_truth_N", "vs dithered truth N", 3),
-    ("dither_rms_N", "dither RMS N", 3),
-    ("penetration_err_mm", "penetration err mm", 2),
-    ("kappa_rel_err_median", "kappa err (median)", 3),
-    ("rib_p99_force_N", "p99 force on ribs N", 2),
-    ("tank_min_J", "tank min J", 3),
+    (
+        "force_rmse_true_N",
+        "force RMSE vs truth N",
+        3,
+        "sensor z force against the reference a perfect map gives "
+        "(-kappa_true eps_d^beta); a dither's swing counts as error",
+    ),
+    (
+        "force_rmse_dithered_truth_N",
+        "vs dithered truth N",
+        3,
+        "the same against the true reference with the run's own dither, the "
+        "error beyond the dither",
+    ),
+    (
+        "dither_rms_N",
+        "dither RMS N",
+        3,
+        "the dither's own part of that reference (0 without a dither)",
+    ),
+    (
+        "penetration_err_mm",
+        "penetration err mm",
+        2,
+        "median |true penetration - eps_d|",
+    ),
+    (
+        "kappa_rel_err_median",
+        "kappa err (median)",
+        3,
+        "median |kappa the reference used / kappa_true - 1|",
+    ),
+    (
+        "rib_p99_force_N",
+        "p99 force on ribs N",
+        2,
+        "p99 of the pressing force where the true kappa is a rib's",
+    ),
+    (
+        "tank_min_J",
+        "tank min J",
+        3,
+        "the lowest tank energy (T_min is the floor)",
+    ),
 )
 
-
 #: One line per column of :func:`comparison_table`, printed under it.
-COLUMN_LEGEND = (
-    "force RMSE vs truth: sensor z force against the reference a perfect map "
-    "gives (-kappa_true eps_d^beta); a dither's swing counts as error",
-    "vs dithered truth: the same against the true reference with the run's own "
-    "dither, the error beyond the dither",
-    "dither RMS: the dither's own part of that reference (0 without a dither)",
-    "penetration err: median |true penetration - eps_d|; kappa err: median "
-    "|kappa the reference used / kappa_true - 1|",
-    "p99 force on ribs: where the true kappa is a rib's; tank min: the lowest "
-    "tank energy (T_min is the floor); all over the scan window",
+COLUMN_LEGEND = tuple(f"{title}: {meaning}" for _, title, _, meaning in _COLUMNS) + (
+    "all over the scan window",
 )
 
 
@@ -292,7 +321,7 @@ def comparison_table(scores: dict) -> str:
     for run, sc in scores.items():
         many = sc if isinstance(sc, list) else [sc]
         cells = []
-        for key, _, digits in _COLUMNS:
+        for key, _, digits, _ in _COLUMNS:
             values = np.array([one[key] for one in many], dtype=float)
             cell = f"{np.mean(values):.{digits}f}"
             low, high = f"{np.min(values):.{digits}f}", f"{np.max(values):.{digits}f}"

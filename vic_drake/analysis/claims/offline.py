@@ -49,7 +49,7 @@ class ModelResiduals:
 
     def as_dict(self) -> dict:
         out = {"kelvin_voigt": self.kelvin_voigt}
-        for beta in sorted(self.hunt_crossley):
+        for beta in sorted(self.hunt_crossley, reverse=True):  # Table I order
             out[f"hc_{beta:g}"] = self.hunt_crossley[beta]
         return out
 

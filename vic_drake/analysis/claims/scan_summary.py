@@ -23,7 +23,7 @@ from vic_drake.analysis.contact import (
     pressing_force_N,
     scan_window,
 )
-from vic_drake.analysis.scan_metrics import tank_min_J
+from vic_drake.analysis.scan_metrics import force_rmse_N, tank_min_J
 from vic_drake.control.params import ControllerParams
 from vic_drake.control.references import has_tank as controller_has_tank
 from vic_drake.errors import VicDrakeError
@@ -87,8 +87,8 @@ def scan_metrics(
         end_s: length of the final segment checked for lift-off, s.
 
     Returns:
-        dict with force_rmse_N (pressing force vs reference over the scan
-        window; only when the reference is nonzero there), force_range_N
+        dict with force_rmse_N (:func:`~vic_drake.analysis.scan_metrics.force_rmse_N`
+        over the scan window; only where there is a force reference), force_range_N
         (98th - 2nd percentile of the pressing force in the window),
         peak_force_N (whole run), lifted_off (mean pressing force of the
         last end_s below the contact threshold), lift_commanded (the target
@@ -126,11 +126,11 @@ def scan_metrics(
         out["force_range_N"] = float(hi - lo)
         out["force_mean_N"] = float(np.mean(fw))
         if "force_ref_z_N" in df.columns:
-            ref = -df["force_ref_z_N"].to_numpy(float)[w]
             # Only a controller with a force reference (CF, VS-CF, VS-VF) has a
-            # tracking error; CS's reference column is zero.
-            if np.any(np.abs(ref) > 0):
-                out["force_rmse_N"] = float(np.sqrt(np.mean((fw - ref) ** 2)))
+            # tracking error (force_rmse_N's rule).
+            rmse = force_rmse_N(df, mask=w)
+            if np.isfinite(rmse):
+                out["force_rmse_N"] = rmse
     out.update(_force_cap_metrics(df, w, f, limits))
     if w.any():
         out.update(_contact_loss_metrics(df, w, limits))

@@ -34,27 +34,56 @@ def _decimate(x, y, field, max_pixels: int):
     return x[::sx], y[::sy], np.asarray(field)[::sx, ::sy]
 
 
+def _tissue_points(tmap: TissueMap):
+    """(x, y) of the map's accepted palpation points, m."""
+    ok = tmap.points[tmap.points["ok"]]
+    return ok["x_m"], ok["y_m"]
+
+
 def _panel(
-    fig, ax, tmap: TissueMap, field, label: str, *, points: bool, max_pixels: int
+    fig,
+    ax,
+    x_m,
+    y_m,
+    field,
+    label: str,
+    *,
+    max_pixels: int,
+    points_m=None,
+    ribs_m=(),
+    limits=(None, None),
 ):
-    x, y, f = _decimate(tmap.x_m, tmap.y_m, field, max_pixels)
+    """One map on the (x, y) grid in cm, with optional points and rib lines;
+    ``limits``: the colour scale's (min, max), None for the field's own."""
+    x, y, f = _decimate(np.asarray(x_m), np.asarray(y_m), field, max_pixels)
     image = ax.imshow(
         f.T,
         origin="lower",
         extent=(100 * x[0], 100 * x[-1], 100 * y[0], 100 * y[-1]),
         cmap=CMAP,
+        vmin=limits[0],
+        vmax=limits[1],
         aspect="equal",
         interpolation="nearest",
     )
-    if points:
-        ok = tmap.points[tmap.points["ok"]]
-        ax.plot(100 * ok["x_m"], 100 * ok["y_m"], "k.", ms=1.5, alpha=0.5)
+    if points_m is not None:
+        px, py = points_m
+        ax.plot(100 * np.asarray(px), 100 * np.asarray(py), "k.", ms=1.5, alpha=0.5)
+    for xr in ribs_m:
+        ax.axvline(100 * xr, color="r", ls=":", lw=1)
     ax.set_xlabel("x [cm]")
     ax.set_ylabel("y [cm]")
     # A wide map in a narrow panel: few enough x ticks that labels never meet.
     ax.xaxis.set_major_locator(MaxNLocator(nbins=5))
     fig.colorbar(image, ax=ax, label=label, shrink=0.85)
     return image
+
+
+def _map_panel(fig, ax, tmap: TissueMap, field, label, *, points, max_pixels):
+    pts = _tissue_points(tmap) if points else None
+    return _panel(
+        fig, ax, tmap.x_m, tmap.y_m, field, label, max_pixels=max_pixels, points_m=pts
+    )
 
 
 def plot_stiffness_damping_maps(
@@ -69,7 +98,7 @@ def plot_stiffness_damping_maps(
     fig = new_figure(figsize=(7.0, 6.5))
     axes = fig.subplots(2, 1)
     beta = tmap.beta
-    _panel(
+    _map_panel(
         fig,
         axes[0],
         tmap,
@@ -79,7 +108,7 @@ def plot_stiffness_damping_maps(
         max_pixels=max_pixels,
     )
     axes[0].set_title("Elasticity κ (GP mean)")
-    _panel(
+    _map_panel(
         fig,
         axes[1],
         tmap,
@@ -100,7 +129,7 @@ def plot_std_maps(
     """Posterior std of the kappa and lambda GP maps."""
     fig = new_figure(figsize=(7.0, 6.5))
     axes = fig.subplots(2, 1)
-    _panel(
+    _map_panel(
         fig,
         axes[0],
         tmap,
@@ -110,7 +139,7 @@ def plot_std_maps(
         max_pixels=max_pixels,
     )
     axes[0].set_title("Elasticity κ: GP posterior std")
-    _panel(
+    _map_panel(
         fig, axes[1], tmap, tmap.lam_std, "std λ", points=points, max_pixels=max_pixels
     )
     axes[1].set_title("Viscosity λ: GP posterior std")
@@ -173,11 +202,15 @@ def plot_map_vs_truth(
     """True kappa, the map's kappa, their relative error, and the rib scan line."""
     fig = new_figure(figsize=(11.0, 6.0))
     axes = fig.subplots(2, 2)
-    _panel(fig, axes[0, 0], tmap, truth_kappa, "κ", points=False, max_pixels=max_pixels)
+    _map_panel(
+        fig, axes[0, 0], tmap, truth_kappa, "κ", points=False, max_pixels=max_pixels
+    )
     axes[0, 0].set_title("Phantom κ (truth)")
-    _panel(fig, axes[0, 1], tmap, tmap.kappa, "κ", points=True, max_pixels=max_pixels)
+    _map_panel(
+        fig, axes[0, 1], tmap, tmap.kappa, "κ", points=True, max_pixels=max_pixels
+    )
     axes[0, 1].set_title("GP map κ")
-    _panel(
+    _map_panel(
         fig,
         axes[1, 0],
         tmap,
@@ -203,4 +236,67 @@ def plot_map_vs_truth(
     ax.set_ylabel("κ")
     ax.set_title(f"κ along y = {100 * y_line_m:.1f} cm")
     ax.legend(fontsize=8)
+    return _finish(fig, save_path)
+
+
+def _shared_limits(fields) -> tuple[float, float]:
+    fields = [np.asarray(f) for f in fields]
+    return (
+        float(min(np.nanmin(f) for f in fields)),
+        float(max(np.nanmax(f) for f in fields)),
+    )
+
+
+def plot_maps_vs_paper(
+    tmap: TissueMap,
+    paper_map=None,
+    *,
+    ribs_m=(),
+    paper_ribs_m=(),
+    max_pixels: int = 400,
+    save_path=None,
+) -> Figure:
+    """The estimated kappa and lambda maps with their ribs (top) and, when
+    given, the paper's measured map (bottom), on the same cm axes and, per
+    column, the same colour scale.
+
+    Args:
+        paper_map: anything with ``x_m``, ``y_m``, ``kappa`` and ``lam`` grids
+            (:class:`~vic_drake.realdata.PhantomMapData`), or None.
+        ribs_m, paper_ribs_m: rib x positions (m), drawn as red dotted lines.
+    """
+    maps = [(tmap, "estimated", ribs_m, _tissue_points(tmap))]
+    if paper_map is not None:
+        maps.append((paper_map, "the paper's measured map", paper_ribs_m, None))
+    fig = new_figure(figsize=(11.0, 3.6 * len(maps)))
+    axes = fig.subplots(len(maps), 2, squeeze=False)
+    beta = tmap.beta
+    kappa_limits = _shared_limits(m.kappa for m, *_ in maps)
+    lam_limits = _shared_limits(m.lam for m, *_ in maps)
+    for row, (m, name, ribs, pts) in zip(axes, maps):
+        kw = dict(max_pixels=max_pixels)
+        _panel(
+            fig,
+            row[0],
+            m.x_m,
+            m.y_m,
+            m.kappa,
+            f"κ [N/m^{beta:g}]",
+            points_m=pts,
+            ribs_m=ribs,
+            limits=kappa_limits,
+            **kw,
+        )
+        row[0].set_title(f"Elasticity κ, {name}", fontsize=9)
+        _panel(
+            fig,
+            row[1],
+            m.x_m,
+            m.y_m,
+            m.lam,
+            f"λ [N s/m^{beta + 1:g}]",
+            limits=lam_limits,
+            **kw,
+        )
+        row[1].set_title(f"Viscosity λ, {name}", fontsize=9)
     return _finish(fig, save_path)

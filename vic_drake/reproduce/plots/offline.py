@@ -38,7 +38,7 @@ def _as_mapping(value, default_name: str) -> dict:
 
 def _table_rows(comparison: ModelComparison) -> list[tuple[str, float]]:
     rows = [("Kelvin-Voigt", comparison.kelvin_voigt.relative)]
-    for beta, fit in sorted(comparison.hunt_crossley.items(), reverse=True):
+    for beta, fit in comparison.hunt_crossley.items():
         rows.append((f"HC β={beta:g}", fit.relative))
     return rows
 
@@ -68,7 +68,7 @@ def plot_table_i(
         ax.bar(x + (i - (len(names) - 1) / 2) * width, values, width, label=name)
     if paper is not None:
         first = comparisons[names[0]]
-        keys = ["kelvin_voigt"] + sorted(first.hunt_crossley, reverse=True)
+        keys = ["kelvin_voigt", *first.hunt_crossley]
         values = [paper.get(k, np.nan) for k in keys]
         ax.plot(x, values, "k_", markersize=24, markeredgewidth=2.5, label="paper")
     ax.set_xticks(x, labels)

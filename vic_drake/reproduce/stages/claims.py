@@ -10,19 +10,32 @@ from vic_drake.jsonio import to_json
 from vic_drake.reproduce.context import RunContext
 from vic_drake.reproduce.report import ReportTable
 
-#: Metrics of vic_drake.analysis.claims.scan_metrics shown in the scan tables.
-_TABLE_KEYS = (
-    "force_rmse_N",
-    "force_range_N",
-    "peak_force_N",
-    "lifted_off",
-    "penetration_error_off_ribs_median_m",
-    "force_on_ribs_p99_N",
-    "n_contact_losses",
-    "fraction_at_k_min_during_loss",
-    "tank_min_J",
-    "tank_power_min_W",
+#: Metrics of vic_drake.analysis.claims.scan_metrics shown in the scan tables,
+#: with the column's name and the factor to it (a penetration reads in mm).
+_TABLE_COLUMNS = (
+    ("force_rmse_N", "force_rmse_N", 1.0),
+    ("force_range_N", "force_range_N", 1.0),
+    ("peak_force_N", "peak_force_N", 1.0),
+    ("lifted_off", "lifted_off", None),
+    (
+        "penetration_error_off_ribs_median_m",
+        "penetration_error_off_ribs_median_mm",
+        1e3,
+    ),
+    ("force_on_ribs_p99_N", "force_on_ribs_p99_N", 1.0),
+    ("n_contact_losses", "n_contact_losses", None),
+    ("fraction_at_k_min_during_loss", "fraction_at_k_min_during_loss", 1.0),
+    ("tank_min_J", "tank_min_J", 1.0),
+    ("tank_power_min_W", "tank_power_min_W", 1.0),
 )
+
+
+def _cell(value, scale):
+    # NaN (CS's and CF's tank: they have none) shows as a missing metric
+    # does: a dash.
+    if value is None or value != value:
+        return None
+    return value if scale is None else value * scale
 
 
 def gather_claim_inputs(ctx: RunContext) -> claims_mod.ClaimInputs:
@@ -89,15 +102,13 @@ def _metrics_table(ctx: RunContext, title: str, metrics: dict) -> None:
     rows = []
     for cond, by_ctrl in metrics.items():
         for ctrl, m in by_ctrl.items():
-            # NaN (CS's and CF's tank: they have none) shows as a missing
-            # metric does: a dash.
-            values = (m.get(k) for k in _TABLE_KEYS)
-            rows.append([cond, ctrl, *(None if v != v else v for v in values)])
+            cells = (_cell(m.get(k), scale) for k, _, scale in _TABLE_COLUMNS)
+            rows.append([cond, ctrl, *cells])
     if rows:
         ctx.tables.append(
             ReportTable(
                 title,
-                ["condition", "controller", *_TABLE_KEYS],
+                ["condition", "controller", *(name for _, name, _ in _TABLE_COLUMNS)],
                 rows,
                 "See vic_drake.analysis.claims.scan_metrics for definitions.",
             )

@@ -28,6 +28,7 @@ def stage_map(ctx: RunContext) -> dict:
     # and the plots matplotlib (heavy).
     from vic_drake.experiments import CampaignParams, run_map_pipeline
     from vic_drake.reproduce.plots.maps import (
+        plot_maps_vs_paper,
         plot_stiffness_damping_maps,
         plot_surface_kappa,
     )
@@ -75,8 +76,8 @@ def stage_map(ctx: RunContext) -> dict:
     ctx.add_figure(
         "Fig. 4: GP maps of kappa and lambda",
         f"GP maps every {res * 1e3:g} mm from {len(pts)} palpations simulated on a 1 cm grid "
-        f"of the {ctx.phantom_kind} phantom over x {region[0]:.3f}..{region[1]:.3f} m, "
-        f"y {region[2]:.3f}..{region[3]:.3f} m (dots: palpation points).",
+        f"of the {ctx.phantom_kind} phantom over x {100 * region[0]:.1f}..{100 * region[1]:.1f}"
+        f" cm, y {100 * region[2]:.1f}..{100 * region[3]:.1f} cm (dots: palpation points).",
         plot_stiffness_damping_maps(tmap),
         "fig4_gp_maps.png",
     )
@@ -85,20 +86,21 @@ def stage_map(ctx: RunContext) -> dict:
         + (" and the paper's measured map" if real_map is not None else ""),
         "The estimated maps with the detected ribs (red dotted lines)"
         + (
-            "; bottom: the paper's own GP map"
+            "; bottom: the paper's own GP map, on the same colour scale per column"
             if real_map is not None
             else " (no paper's map in this run: the real data is absent)"
         )
         + ". kappa relative RMS error of the estimate against the phantom: "
         f"{out['kappa_rel_rmse']:.1%}.",
-        _plot_maps(
+        plot_maps_vs_paper(
             tmap,
-            pts,
             real_map,
-            out["ribs_sim"],
-            rib_prominences(real_map.x_m, real_map.y_m, real_map.kappa)
+            ribs_m=out["ribs_sim"]["rib_position_m"],
+            paper_ribs_m=rib_prominences(real_map.x_m, real_map.y_m, real_map.kappa)[
+                "rib_position_m"
+            ]
             if real_map is not None
-            else None,
+            else (),
         ),
         "fig4_maps_vs_paper.png",
     )
@@ -110,61 +112,3 @@ def stage_map(ctx: RunContext) -> dict:
         "fig5_surface_kappa.png",
     )
     return out
-
-
-def _plot_maps(tmap, pts, real_map, ribs_sim, ribs_real):
-    # Function-local: matplotlib is heavy.
-    from vic_drake.reproduce.plots.figure import new_figure
-
-    rows = 2 if real_map is not None else 1
-    fig = new_figure(figsize=(11, 3.6 * rows))
-    axes = fig.subplots(rows, 2, squeeze=False)
-    step = max(1, int(np.ceil(tmap.x_m.size / 400)))
-
-    def show(ax, x, y, grid, title, ribs=None):
-        ext = [x[0], x[-1], y[0], y[-1]]
-        im = ax.imshow(
-            grid.T, origin="lower", extent=ext, aspect="equal", cmap="viridis"
-        )
-        fig.colorbar(im, ax=ax, shrink=0.8)
-        ax.set_title(title, fontsize=9)
-        ax.set_xlabel("x [m]")
-        ax.set_ylabel("y [m]")
-        for xr in (ribs or {}).get("rib_position_m", []):
-            ax.axvline(xr, color="r", ls=":", lw=1)
-
-    xs, ys = tmap.x_m[::step], tmap.y_m[::step]
-    show(
-        axes[0, 0],
-        xs,
-        ys,
-        tmap.kappa[::step, ::step],
-        "kappa, estimated [N/m^beta]",
-        ribs_sim,
-    )
-    axes[0, 0].plot(pts["x_m"], pts["y_m"], "k.", ms=2)
-    show(
-        axes[0, 1],
-        xs,
-        ys,
-        tmap.lam[::step, ::step],
-        "lambda, estimated [N s/m^(beta+1)]",
-    )
-    if real_map is not None:
-        show(
-            axes[1, 0],
-            real_map.x_m,
-            real_map.y_m,
-            real_map.kappa,
-            "kappa, the paper's measured map",
-            ribs_real,
-        )
-        show(
-            axes[1, 1],
-            real_map.x_m,
-            real_map.y_m,
-            real_map.lam,
-            "lambda, the paper's measured map",
-        )
-    fig.tight_layout()
-    return fig
