@@ -177,3 +177,15 @@ def test_ctrl_c_while_the_commands_load_is_no_traceback(monkeypatch, capsys):
     monkeypatch.setattr(cli, "build_parser", interrupted)
     assert cli.main(["campaign", "--help"]) == 130
     assert capsys.readouterr().err.strip() == "vic-drake: interrupted"
+
+
+def test_allow_code_change_goes_with_resume(capsys, tmp_path):
+    from pathlib import Path
+
+    smoke = Path(__file__).resolve().parents[2] / "campaigns" / "smoke.yaml"
+    status, _, err = run(
+        capsys, ["campaign", smoke, "--out", tmp_path / "c", "--allow-code-change"]
+    )
+    assert status == 2
+    assert "--allow-code-change goes with --resume" in err
+    assert not (tmp_path / "c").exists()

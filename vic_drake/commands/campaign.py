@@ -15,6 +15,7 @@ import argparse
 import math
 
 from vic_drake.commands.common import Progress, add_json_option, emit, help_text
+from vic_drake.errors import VicDrakeError
 from vic_drake.experiments.dask_cluster import add_cluster_arguments
 
 #: The keys --json prints (the command's contract), in order.
@@ -57,6 +58,13 @@ def register(subparsers) -> None:
         "--resume",
         action="store_true",
         help="finish the campaign already in --out (a new or empty --out: start it)",
+    )
+    p.add_argument(
+        "--allow-code-change",
+        action="store_true",
+        help="with --resume: add this code's rows to rows other code computed "
+        "(refused otherwise: another vic_drake source, Drake or Python; the "
+        "summary then counts the rows per code)",
     )
     add_json_option(p)
     p.set_defaults(handler=run_campaign_command)
@@ -105,6 +113,12 @@ def _human(result: dict) -> str:
             f"{_num(v['tank_min_J'], 10, 3)} {v['watchdog_stops']:>8}"
         )
     lines += [f"  {line}" for line in console_legend(limit)]
+    codes = result.get("code_ids", {})
+    if len(codes) > 1:
+        lines.append(
+            "rows from more than one code (--allow-code-change): "
+            + "; ".join(f"{n} by {c}" for c, n in codes.items())
+        )
     for c in result.get("paired", []):
         loss, over = c["contact_loss"], c["exceedance"]
         lines.append(
@@ -122,6 +136,10 @@ def _human(result: dict) -> str:
 def run_campaign_command(args: argparse.Namespace) -> int:
     from vic_drake.experiments.campaign import run_campaign
 
+    if args.allow_code_change and not args.resume:
+        raise VicDrakeError(
+            "--allow-code-change goes with --resume (it lets a resume mix codes)"
+        )
     result = run_campaign(
         args.spec,
         args.out,
@@ -129,6 +147,7 @@ def run_campaign_command(args: argparse.Namespace) -> int:
         scheduler=args.scheduler,
         resume=args.resume,
         progress=Progress(True),
+        allow_code_change=args.allow_code_change,
     )
     out = {key: result[key] for key in JSON_KEYS}
     out["per_controller"] = {

@@ -22,6 +22,7 @@ import time
 from vic_drake.ctrl_c import hold_ctrl_c, release_ctrl_c
 from vic_drake.errors import VicDrakeError
 from vic_drake.malloc_tuning import allocator
+from vic_drake.provenance import code_id
 
 
 def dask_client(workers: int | None, scheduler: str | None):
@@ -148,10 +149,27 @@ def quiet_logs(quiet: bool):
             lg.setLevel(level)
 
 
+def check_worker_code(client) -> None:
+    """Refuses a cluster whose workers run other code than this process
+    (:func:`vic_drake.provenance.code_id`: vic_drake's source, Drake and
+    Python): their results would not be this code's."""
+    here = code_id()
+    other = {addr: c for addr, c in client.run(code_id).items() if c != here}
+    if other:
+        shown = "; ".join(f"{a}: {c}" for a, c in sorted(other.items())[:3])
+        more = f" (and {len(other) - 3} more)" if len(other) > 3 else ""
+        raise VicDrakeError(
+            f"{len(other)} Dask worker(s) run other code than this process "
+            f"({here}): {shown}{more}. Their results would not be this code's: "
+            "install the same vic_drake, Drake and Python on the workers"
+        )
+
+
 @contextlib.contextmanager
 def dask_session(workers: int | None, scheduler: str | None):
     """Yields ``(client, futures)``: a client of :func:`dask_client` and a
-    dict for the caller's futures. On leaving (also on Ctrl-C, which
+    dict for the caller's futures, once every worker is found to run this
+    process's code (:func:`check_worker_code`). On leaving (also on Ctrl-C, which
     :func:`ctrl_c_stops_once` turns into one KeyboardInterrupt) the futures
     are cancelled and the client and a local cluster closed, with Dask's
     warnings about the cancelled work hidden after Ctrl-C."""
@@ -160,6 +178,7 @@ def dask_session(workers: int | None, scheduler: str | None):
     with ctrl_c_stops_once():
         client, cluster = dask_client(workers, scheduler)
         try:
+            check_worker_code(client)
             yield client, futures
         except KeyboardInterrupt:
             interrupted = True
@@ -287,6 +306,7 @@ def add_cluster_arguments(
 __all__ = [
     "add_cluster_arguments",
     "check_scheduler",
+    "check_worker_code",
     "ctrl_c_stops_once",
     "dask_client",
     "dask_session",

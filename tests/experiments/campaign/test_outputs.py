@@ -5,6 +5,7 @@ reached (a fake cluster that fails stands in for Dask); CS and CF have no
 tank, so their tank figures are NaN and show as a dash.
 """
 
+import json
 import math
 from pathlib import Path
 
@@ -16,6 +17,7 @@ from vic_drake.commands.campaign import _human
 from vic_drake.errors import VicDrakeError
 from vic_drake.experiments.campaign import engine, run_campaign, run_metrics
 from vic_drake.experiments.campaign.report import summary_html
+from vic_drake.experiments.campaign.run import failed_row
 from vic_drake.experiments.campaign.spec import CampaignSpec
 from vic_drake.experiments.campaign.stats import per_controller
 
@@ -84,6 +86,78 @@ def test_resume_without_a_campaign_says_so_and_starts(tmp_path, no_cluster):
     with pytest.raises(_NoCluster):
         run_campaign(SMOKE, out, workers=1, resume=True, progress=lines.append)
     assert lines == [f"nothing to resume: {str(out)!r} is empty; starting the campaign"]
+
+
+def _stored_campaign(out: Path, codes) -> list[str]:
+    """A campaign folder of SMOKE's spec with one stored row per code in
+    ``codes`` (None: a row without one); returns the listing."""
+    from vic_drake.experiments.campaign.plan import plan_campaign
+    from vic_drake.experiments.campaign.spec import load_campaign_spec
+    from vic_drake.scenario import load_scenario
+
+    spec, base = load_campaign_spec(SMOKE)
+    engine._create(out, engine._spec_text(spec, base))
+    plans = plan_campaign(spec, load_scenario(base))
+    for plan, code in zip(plans, codes):
+        row = failed_row(plan, "a stand-in row", wall_s=0.0)
+        row.pop("code_id")
+        if code is not None:
+            row["code_id"] = code
+        (out / "rows" / f"{plan.run_id}.json").write_text(json.dumps(row))
+    return _listing(out)
+
+
+def test_a_resume_with_other_code_is_refused_before_any_work(tmp_path, no_cluster):
+    """Rows another code computed (another source, Drake or Python, or a row
+    from before rows carried their code) are not mixed with this code's."""
+    from vic_drake.provenance import code_id
+
+    out = tmp_path / "c"
+    other = "0123456789ab drake 1.40.0 py 3.10.0"
+    before = _stored_campaign(out, [code_id(), other, other, None])
+    with pytest.raises(VicDrakeError) as err:
+        run_campaign(SMOKE, out, workers=1, resume=True)
+    text = str(err.value)
+    assert f"holds rows computed by other code (2 by {other}; 1 by unknown" in text
+    assert f"this is {code_id()}" in text and "--allow-code-change" in text
+    assert _listing(out) == before
+    # Allowed, it goes on to the cluster.
+    with pytest.raises(_NoCluster):
+        run_campaign(SMOKE, out, workers=1, resume=True, allow_code_change=True)
+    # Rows of this code alone resume.
+    same = tmp_path / "same"
+    _stored_campaign(same, [code_id(), code_id()])
+    with pytest.raises(_NoCluster):
+        run_campaign(SMOKE, same, workers=1, resume=True)
+
+
+def test_a_finished_campaign_of_other_code_is_summarised_again(tmp_path, no_cluster):
+    """With no run left to do, a resume mixes nothing: it writes the summary
+    of the stored rows (no cluster needed), naming their code."""
+    out = tmp_path / "done"
+    other = "0123456789ab drake 1.40.0 py 3.10.0"
+    _stored_campaign(out, [other] * 16)
+    summary = run_campaign(SMOKE, out, workers=1, resume=True)
+    assert summary["code_ids"] == {other: 16} and summary["session_runs"] == 0
+    assert f"Code: {other}." in (out / "summary.html").read_text()
+
+
+def test_the_summary_counts_the_rows_per_code():
+    from vic_drake.experiments.campaign.engine import UNKNOWN_CODE, summary_dict
+
+    spec = CampaignSpec(runs=3)
+    rows = _rows().assign(code_id=["a", "b", None])
+    summary = summary_dict(spec, rows)
+    assert summary["code_ids"] == {"a": 1, "b": 1, UNKNOWN_CODE: 1}
+    page = summary_html(Path("."), spec, rows, summary)
+    assert "The rows come from more than one code" in page and "1 by b" in page
+    assert "more than one code" in _human(
+        {**_result(3), "code_ids": summary["code_ids"]}
+    )
+    one = summary_dict(spec, rows.assign(code_id="a"))
+    assert one["code_ids"] == {"a": 3}
+    assert "Code: a." in summary_html(Path("."), spec, rows, one)
+    assert "code" not in _human({**_result(3), "code_ids": one["code_ids"]})
 
 
 def test_a_campaign_that_cannot_start_leaves_no_folder(tmp_path, monkeypatch):

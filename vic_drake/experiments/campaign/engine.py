@@ -26,6 +26,12 @@ local cluster; an external scheduler uses its own setting), then the run is
 recorded as failed. ``resume`` skips every run with a row and never runs
 one twice.
 
+Each row carries the ``code_id`` (:func:`vic_drake.provenance.code_id`) of
+the process that computed it. A resume whose code differs from the stored
+rows' is refused unless ``allow_code_change`` (the summary then counts the
+rows per code). Workers whose code differs from this process's are refused
+when the cluster is reached (:func:`~vic_drake.experiments.dask_cluster.dask_session`).
+
 Ctrl-C stops the campaign: the local workers ignore it (the runs' own
 processes stop on it), the campaign closes the cluster with Dask's
 warnings hidden, says how many runs are kept and the command that finishes
@@ -57,6 +63,7 @@ from vic_drake.paths import (
     CAMPAIGN_SPEC_FILE,
     check_run_folder,
 )
+from vic_drake.provenance import code_id
 from vic_drake.scenario import dumps_scenario, load_scenario
 
 
@@ -83,13 +90,19 @@ def read_rows(out: Path) -> pd.DataFrame:
 
 
 def _check_out(
-    out: Path, spec_text: str, plans: list[RunPlan], resume: bool, emit
+    out: Path,
+    spec_text: str,
+    plans: list[RunPlan],
+    resume: bool,
+    emit,
+    allow_code_change: bool = False,
 ) -> set[str]:
     """Checks ``out`` before any work, writing nothing; returns the run ids
     already finished there.
 
     ``out`` may be new, an empty folder, or (with ``resume``) this
-    campaign's folder; a folder holding anything else is refused, so a
+    campaign's folder, whose rows were computed by this code (or
+    ``allow_code_change``); a folder holding anything else is refused, so a
     campaign never mixes its files into another run's folder.
     """
     stored = out / CAMPAIGN_SPEC_FILE
@@ -107,13 +120,47 @@ def _check_out(
                 f"{str(out)!r} holds another campaign spec; --resume needs the same spec"
             )
         planned = {p.run_id for p in plans}
-        return {p.stem for p in (out / "rows").glob("run_*.json")} & planned
+        done = {p.stem for p in (out / "rows").glob("run_*.json")} & planned
+        if not allow_code_change and len(done) < len(planned):
+            # Runs to add: they must be the stored rows' code's. (With none
+            # left, a resume only summarises the rows again.)
+            _check_stored_code(out, done)
+        return done
     if resume:
         # Starting is what --resume asks for in the end (every run done),
         # and nothing can be lost in a new or empty folder.
         where = "is empty" if out.is_dir() else "does not exist"
         emit(f"nothing to resume: {str(out)!r} {where}; starting the campaign")
     return set()
+
+
+#: What a row written before rows carried their code shows as its code.
+UNKNOWN_CODE = "unknown (a row written before rows recorded their code)"
+
+
+def _stored_codes(out: Path, run_ids) -> dict[str, int]:
+    """{code_id: rows} of the stored rows ``run_ids``."""
+    counts: dict[str, int] = {}
+    for run_id in sorted(run_ids):
+        row = json.loads((out / "rows" / f"{run_id}.json").read_text())
+        code = row.get("code_id") or UNKNOWN_CODE
+        counts[code] = counts.get(code, 0) + 1
+    return counts
+
+
+def _check_stored_code(out: Path, run_ids) -> None:
+    """Refuses a resume whose code is not the stored rows' code."""
+    here = code_id()
+    other = {c: n for c, n in _stored_codes(out, run_ids).items() if c != here}
+    if other:
+        stored = "; ".join(f"{n} by {c}" for c, n in other.items())
+        raise VicDrakeError(
+            f"{str(out)!r} holds rows computed by other code ({stored}); this is "
+            f"{here}. A resume would mix two codes' results in one summary: "
+            "finish it with the code that began it, start again in a new --out, "
+            "or pass --allow-code-change to mix them (the summary then counts "
+            "the rows per code)"
+        )
 
 
 def _create(out: Path, spec_text: str) -> None:
@@ -173,6 +220,7 @@ def run_campaign(
     resume: bool = False,
     progress: Callable[[str], None] | None = None,
     max_runs: int | None = None,
+    allow_code_change: bool = False,
 ) -> dict:
     """Runs (or finishes) a campaign; returns its JSON summary.
 
@@ -185,6 +233,8 @@ def run_campaign(
         progress: callable(str) for progress lines (e.g. to stderr).
         max_runs: stop submitting after this many new runs (for an
             interrupted campaign in tests and benchmarks; None: all).
+        allow_code_change: let a resume add rows of this code to rows that
+            other code computed (refused otherwise).
 
     Returns:
         The summary of :func:`summary_dict` plus ``session_runs`` (the
@@ -201,7 +251,7 @@ def run_campaign(
     out = Path(out)
     emit = progress or (lambda _line: None)
     spec_text = _spec_text(spec, base_path)
-    done = _check_out(out, spec_text, plans, resume, emit)
+    done = _check_out(out, spec_text, plans, resume, emit, allow_code_change)
     todo = [p for p in plans if p.run_id not in done]
     if max_runs is not None:
         todo = todo[:max_runs]
@@ -291,10 +341,20 @@ def summary_dict(spec: CampaignSpec, rows: pd.DataFrame) -> dict:
         "force_limit_N": spec.force_limit_N,
         "contact_threshold_N": CONTACT_THRESHOLD_N,
         "per_controller": per_controller(rows, spec.force_limit_N),
+        "code_ids": _code_counts(rows),
     }
     if spec.paired:
         summary["paired"] = paired_arms(rows, spec.grid_size, spec.force_limit_N)
     return summary
 
 
-__all__ = ["read_rows", "run_campaign", "summary_dict"]
+def _code_counts(rows: pd.DataFrame) -> dict[str, int]:
+    """{code_id: rows}: more than one key when a resume mixed codes."""
+    if rows.empty:
+        return {}
+    codes = rows.get("code_id", pd.Series(UNKNOWN_CODE, index=rows.index))
+    codes = codes.fillna(UNKNOWN_CODE).replace("", UNKNOWN_CODE)
+    return {str(c): int(n) for c, n in codes.value_counts().items()}
+
+
+__all__ = ["UNKNOWN_CODE", "read_rows", "run_campaign", "summary_dict"]

@@ -193,6 +193,15 @@ def _header(spec: CampaignSpec, summary: dict) -> list[str]:
         f"<p>{summary['finished']} of {summary['runs']} runs finished, "
         f"{summary['failed']} failed ({summary['nan_runs']} NaN).</p>"
     )
+    codes = summary.get("code_ids", {})
+    if len(codes) == 1:
+        parts.append(f"<p>Code: {html.escape(next(iter(codes)))}.</p>")
+    elif codes:
+        mixed = "; ".join(f"{n} by {html.escape(c)}" for c, n in codes.items())
+        parts.append(
+            "<p><b>The rows come from more than one code</b> (a resume with "
+            f"--allow-code-change): {mixed}.</p>"
+        )
     return parts
 
 

@@ -21,6 +21,7 @@ from vic_drake.analysis.contact import contact_loss_intervals, scan_window
 from vic_drake.analysis.scan_metrics import tank_min_J
 from vic_drake.control.references import has_tank
 from vic_drake.experiments.campaign.plan import RunPlan
+from vic_drake.provenance import code_id
 from vic_drake.scenario import dumps_scenario
 
 #: The columns whose non-finite values make a run a NaN run.
@@ -96,7 +97,8 @@ def execute_run(plan: RunPlan) -> dict:
 
     Returns:
         A row: run_id, index, status ("ok" | "nan" | "error"), error (text,
-        "" when ok), the sampled factors (``factor.<name>``), the metrics of
+        "" when ok), code_id (:func:`vic_drake.provenance.code_id` of the
+        process that ran it), the sampled factors (``factor.<name>``), the metrics of
         :data:`METRIC_KEYS` (``watchdog_trip_s``: when the force sensor's
         watchdog stopped the scan, NaN if it did not), ``watchdog_cause``
         (what stopped it: "x", "y" or "z" for a stuck channel, "all" for a
@@ -109,6 +111,7 @@ def execute_run(plan: RunPlan) -> dict:
 
     t0 = time.perf_counter()
     row = {"run_id": plan.run_id, "index": plan.index, "status": "ok", "error": ""}
+    row["code_id"] = code_id()
     row.update({f"factor.{k}": v for k, v in plan.factors.items()})
     row.update({k: math.nan for k in METRIC_KEYS})
     row["watchdog_cause"] = ""
@@ -172,6 +175,7 @@ def failed_row(plan: RunPlan, error: str, *, wall_s: float = math.nan) -> dict:
         "index": plan.index,
         "status": "error",
         "error": error,
+        "code_id": code_id(),
     }
     row.update({f"factor.{k}": v for k, v in plan.factors.items()})
     row.update({k: math.nan for k in METRIC_KEYS})

@@ -1,0 +1,61 @@
+"""Which code computed a result: vic_drake's source hash, and the refusal of
+Dask workers that run other code."""
+
+import shutil
+
+import pytest
+
+from vic_drake.errors import VicDrakeError
+from vic_drake.experiments.dask_cluster import check_worker_code
+from vic_drake.provenance import CODE_ID_DIGITS, PACKAGE_DIR, code_id, source_hash
+
+
+def test_the_source_hash_follows_the_modules_and_nothing_else(tmp_path):
+    pkg = tmp_path / "vic_drake"
+    shutil.copytree(PACKAGE_DIR, pkg, ignore=shutil.ignore_patterns("__pycache__"))
+    first = source_hash(pkg)
+    assert first == source_hash(PACKAGE_DIR) and len(first) == CODE_ID_DIGITS
+    # Caches and other files do not count.
+    (pkg / "__pycache__").mkdir(exist_ok=True)
+    (pkg / "__pycache__" / "x.py").write_text("cached = 1\n")
+    (pkg / "notes.txt").write_text("not code")
+    assert source_hash(pkg) == first
+    # One character of one module does.
+    module = pkg / "control" / "tank.py"
+    module.write_text(module.read_text() + "#\n")
+    assert source_hash(pkg) != first
+    module.rename(pkg / "control" / "tank2.py")  # So does a module's name.
+    renamed = source_hash(pkg)
+    assert renamed not in (first, source_hash(PACKAGE_DIR))
+
+
+def test_the_code_id_names_the_source_drake_and_python():
+    import platform
+
+    here = code_id()
+    assert here.startswith(source_hash() + " drake ")
+    assert here.endswith(f" py {platform.python_version()}")
+
+
+class _Client:
+    def __init__(self, ids: dict):
+        self.ids = ids
+
+    def run(self, function):
+        assert function is code_id  # Each worker computes its own.
+        return self.ids
+
+
+def test_workers_with_other_code_are_refused_by_name():
+    here = code_id()
+    check_worker_code(_Client({"tcp://a:1": here, "tcp://b:2": here}))
+    other = "0123456789ab drake 1.40.0 py 3.10.0"
+    with pytest.raises(VicDrakeError) as err:
+        check_worker_code(_Client({"tcp://a:1": here, "tcp://b:2": other}))
+    text = str(err.value)
+    assert text.startswith("1 Dask worker(s) run other code than this process")
+    assert f"tcp://b:2: {other}" in text and "tcp://a:1" not in text
+    assert here in text and "install the same vic_drake, Drake and Python" in text
+    many = {f"tcp://w:{i}": other for i in range(5)}
+    with pytest.raises(VicDrakeError, match=r"^5 Dask worker.*\(and 2 more\)"):
+        check_worker_code(_Client(many))
