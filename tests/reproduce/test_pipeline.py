@@ -34,7 +34,11 @@ def test_real_logs_claims_and_report(tmp_path, data_dir):
     assert claims["C4"]["real"]["rmse_ratio"] < 1.0
     assert claims["C7"]["real"] is None and "VS-VF" in claims["C7"]["detail"]
     assert result.report_path.is_file()
-    assert "Claims (0 of 7 pass" in result.report_path.read_text()
+    page = result.report_path.read_text()
+    assert "Claims (0 of 7 pass" in page
+    from vic_drake.provenance import code_id
+
+    assert code_id() in page  # The code that made it.
 
 
 @pytest.mark.slow

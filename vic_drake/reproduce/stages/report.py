@@ -10,6 +10,7 @@ import time
 
 from vic_drake.analysis.claims.reasons import c2_misses
 from vic_drake.analysis.claims.thresholds import C2_MAX_RATIO, C2_MIN_R2
+from vic_drake.provenance import code_id
 from vic_drake.reproduce.context import RunContext
 from vic_drake.reproduce.report import ReportContent, write_report
 
@@ -214,6 +215,7 @@ def stage_report(ctx: RunContext) -> dict:
         tables=sorted(ctx.tables, key=lambda t: _paper_order(t.title)),
         metadata={
             **{f"version {k}": v for k, v in package_versions().items()},
+            "code (vic_drake source hash, Drake, Python)": code_id(),
             "data folder": str(ctx.data_dir) if ctx.data_dir else "not found",
             "mode": mode,
             "phantom": ctx.phantom_kind,
