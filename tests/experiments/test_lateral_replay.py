@@ -111,13 +111,21 @@ def test_a_lateral_pass_brings_the_simulated_tip_onto_the_real_path(data_dir):
     # wrong sign or size would not.
     from vic_drake.experiments.compare_real import compare_real
 
+    lines = []
     out = compare_real(
         data_dir / "experiments" / "test_force_control_dist",
         data_dir=data_dir,
         duration_s=5.0,
         lateral_passes=1,
+        progress=lines.append,
     )
     assert out["lateral_passes"] == 1
     before, after = out["lateral_rms_mm"]
     assert before > 1.0
     assert after < 0.6 * before
+    # The progress says which run is the pass, and what it corrects.
+    (line,) = [x for x in lines if x.startswith("lateral pass")]
+    assert line == (
+        "lateral pass 1 of 1: the path corrected by the last run's lateral "
+        f"error ({before:.2f} mm RMS)"
+    )

@@ -305,7 +305,12 @@ def compare_real(
     )
     window = scan_window(real)
     lateral_rms = [lateral_rms_mm(result.df, real, window)]
-    for _ in range(lateral_passes):
+    for n in range(1, lateral_passes + 1):
+        if progress:
+            progress(
+                f"lateral pass {n} of {lateral_passes}: the path corrected by the "
+                f"last run's lateral error ({lateral_rms[-1]:.2f} mm RMS)"
+            )
         start_z = scenario.trajectory.initial_tip_z_m
         if start_z is None:
             start_z = scenario.trajectory.approach_z_m
