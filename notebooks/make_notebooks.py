@@ -136,7 +136,10 @@ def nb_scan_controllers():
             "VS-CF: stiffness from the QP tracking 7 N, penetration limited by the map. "
             "VS-VF: the force that keeps 8 mm of penetration, capped at F_min = -9 N over "
             "the ribs. All four run through the same Drake diagram "
-            "(`vic_drake.experiments.MakeScanDiagram`)."
+            "(`vic_drake.experiments.MakeScanDiagram`).\n\n"
+            "To stay short, the notebook runs the quick scans of `vic-drake reproduce "
+            "--quick` (5 cm of scan, not the paper's 20 cm; `quick=False` below, or "
+            "`diagrams/nominal_*.yaml`, gives the full scans)."
         ),
         new_code_cell(SETUP),
         new_code_cell(
@@ -182,7 +185,10 @@ def nb_disturbance():
             "phantom's `phantom.lift` input raises it by 15 mm, then drops it below its "
             "rest, so the probe loses contact and touches again. VS-VF's energy tank "
             "and power valve keep K at K_min while contact is lost and limit its rise "
-            "at re-contact; CS and CF have no such limits."
+            "at re-contact; CS and CF have no such limits.\n\n"
+            "To stay short, the notebook runs the quick scans of `vic-drake reproduce "
+            "--quick` (a 5 cm scan with one disturbance event, not two; `quick=False` "
+            "below gives the full scans)."
         ),
         new_code_cell(SETUP),
         new_code_cell(

@@ -32,9 +32,11 @@ def test_the_source_hash_follows_the_modules_and_nothing_else(tmp_path):
 def test_the_code_id_names_the_source_drake_and_python():
     import platform
 
+    from vic_drake import __version__
+
     here = code_id()
-    assert here.startswith(source_hash() + " drake ")
-    assert here.endswith(f" py {platform.python_version()}")
+    assert here.startswith(f"vic_drake {__version__} source {source_hash()}, drake ")
+    assert here.endswith(f", python {platform.python_version()}")
 
 
 class _Client:
@@ -49,7 +51,7 @@ class _Client:
 def test_workers_with_other_code_are_refused_by_name():
     here = code_id()
     check_worker_code(_Client({"tcp://a:1": here, "tcp://b:2": here}))
-    other = "0123456789ab drake 1.40.0 py 3.10.0"
+    other = "vic_drake 0.1.0 source 0123456789ab, drake 1.40.0, python 3.10.0"
     with pytest.raises(VicDrakeError) as err:
         check_worker_code(_Client({"tcp://a:1": here, "tcp://b:2": other}))
     text = str(err.value)

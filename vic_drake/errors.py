@@ -33,6 +33,12 @@ def check_number(
     Raises:
         VicDrakeError: "<owner>.<name> must be ...; got <value>".
     """
+    # Text that reads as a number ("5") would pass float() and stay text in
+    # the field, to fail deep in a simulation; true/false is no number.
+    if isinstance(value, (str, bytes, bool)):
+        raise VicDrakeError(
+            f"{owner}.{name} must be a number; got {value!r} (a {type(value).__name__})"
+        )
     try:
         v = float(value)
     except (TypeError, ValueError):
@@ -45,3 +51,42 @@ def check_number(
     if high is not None and v > high:
         raise VicDrakeError(f"{owner}.{name} must be <= {high}; got {value!r}")
     return v
+
+
+def check_known_attributes(obj, owner: str) -> None:
+    """Refuses an attribute that is not a field, on a dataclass and on every
+    dataclass in its fields (lists and dicts of them included).
+
+    Python lets code set any attribute: ``params.force_ref = 5.0`` (for
+    ``force_ref_N``) would be kept and never read. The YAML loader refuses
+    such a key; this gives the same for a config changed in code.
+
+    Raises:
+        VicDrakeError: "<owner>.<path> has no field 'x'; did you mean ...".
+    """
+    import dataclasses
+    import difflib
+
+    if not dataclasses.is_dataclass(obj) or isinstance(obj, type):
+        return
+    fields = [f.name for f in dataclasses.fields(obj)]
+    for name in getattr(obj, "__dict__", {}):
+        if name not in fields and not name.startswith("_"):
+            near = difflib.get_close_matches(name, fields, n=3, cutoff=0.5)
+            hint = f"; did you mean {', '.join(near)}?" if near else ""
+            raise VicDrakeError(
+                f"{owner} has no field {name!r} (set in code, it would be "
+                f"ignored){hint} Its fields: {', '.join(fields)}"
+            )
+    for name in fields:
+        value = getattr(obj, name)
+        items = (
+            value.items()
+            if isinstance(value, dict)
+            else enumerate(value)
+            if isinstance(value, (list, tuple))
+            else ()
+        )
+        check_known_attributes(value, f"{owner}.{name}")
+        for key, item in items:
+            check_known_attributes(item, f"{owner}.{name}[{key!r}]")

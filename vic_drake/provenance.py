@@ -50,12 +50,18 @@ def _version(name: str) -> str:
 
 @functools.cache
 def code_id() -> str:
-    """This process's code: "<source hash> drake <version> py <version>".
+    """This process's code: "vic_drake <version> source <hash>, drake
+    <version>, python <version>".
 
     Two processes with the same id simulate alike; computed once per process
     (about 10 ms).
     """
-    return f"{source_hash()} drake {_version('drake')} py {platform.python_version()}"
+    from vic_drake import __version__
+
+    return (
+        f"vic_drake {__version__} source {source_hash()}, drake {_version('drake')}, "
+        f"python {platform.python_version()}"
+    )
 
 
 __all__ = ["CODE_ID_DIGITS", "PACKAGE_DIR", "code_id", "source_hash"]

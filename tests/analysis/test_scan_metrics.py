@@ -73,3 +73,63 @@ def test_the_log_says_which_controller_has_no_reference_or_tank():
         assert math.isnan(tank_min_J(df))
         assert math.isnan(tank_min_J(df[t > 1.0]))  # A slice keeps it.
         assert tank_min_J(df, has_tank=True) == 0.5  # The argument decides.
+
+
+def test_scan_metrics_scores_a_log_on_its_own_controllers_limits():
+    """run_scan stores the controller's limits in the log: scan_metrics
+    without ``limits`` uses them (CF: no tank, no penetration target; a VS-VF
+    eps_d of 6 mm), and the real controller's defaults on a log without."""
+    import dataclasses
+
+    from vic_drake.analysis.claims import ScanLimits, scan_metrics
+    from vic_drake.control.params import real_controller_params
+
+    t = np.arange(0, 10, 0.002)
+    force = np.where(t < 1, 0.0, 7.0)
+    df = make_scan(
+        t,
+        force,
+        force_ref_z_N=-7.0,
+        force_min_z_N=-9.0,
+        penetration_m=np.where(t < 1, -0.01, 0.006),
+        tank_energy_J=0.5,
+        tank_power_W=0.0,
+    )
+    plain = scan_metrics(df)  # No limits stored: the defaults (eps_d 8 mm).
+    assert plain["penetration_error_off_ribs_median_m"] == pytest.approx(0.002)
+    assert plain["tank_min_J"] == 0.5
+    cf = df.copy()
+    cf.attrs["scan_limits"] = dataclasses.asdict(
+        ScanLimits.from_controller(real_controller_params("cf"))
+    )
+    m = scan_metrics(cf)
+    assert math.isnan(m["tank_min_J"]) and math.isnan(m["tank_power_min_W"])
+    assert "penetration_error_off_ribs_median_m" not in m
+    assert m["penetration_off_ribs_median_m"] == pytest.approx(0.006)
+    params = real_controller_params("vs-vf")
+    params.reference.eps_d_m = 0.006
+    vsvf = df.copy()
+    vsvf.attrs["scan_limits"] = dataclasses.asdict(ScanLimits.from_controller(params))
+    assert scan_metrics(vsvf)["penetration_error_off_ribs_median_m"] == pytest.approx(
+        0.0
+    )
+
+
+def test_metrics_name_what_was_given_instead_of_a_log():
+    from types import SimpleNamespace
+
+    from vic_drake.analysis.claims import scan_metrics
+
+    t = np.arange(0, 4, 0.002)
+    df = make_scan(t, np.where(t < 1, 0.0, 6.0), force_ref_z_N=-5.0)
+    result = SimpleNamespace(df=df)  # As a ScanResult holds its log.
+    with pytest.raises(
+        VicDrakeError, match=r"got a SimpleNamespace \(its log is result\.df\)"
+    ):
+        scan_metrics(result)
+    with pytest.raises(VicDrakeError, match=r"its log is result\.df"):
+        force_rmse_N(result)
+    with pytest.raises(VicDrakeError, match=r"limits must be a ScanLimits"):
+        scan_metrics(df, limits=SimpleNamespace(eps_d_m=0.008))
+    with pytest.raises(VicDrakeError, match=r"one bool per row of the log \(2000\)"):
+        force_rmse_N(df, mask=[True] * 10)

@@ -60,17 +60,84 @@ def test_run_scan_rejects_bad_input():
     [
         ("trajectory", "scan_speed_m_per_s", -0.01, r"scan_speed_m_per_s must be > 0"),
         ("", "seed", -3, r"Scenario\.seed must be an integer >= 0"),
+        # Lengths, speeds and forces typed in other units (a first-contact
+        # review: 48 for a 48 mm lift ran, and reported 8,327 N).
+        (
+            "trajectory",
+            "liftoff_height_m",
+            48.0,
+            r"liftoff_height_m is in metres and must be at most 0.2 m; got 48.0",
+        ),
+        (
+            "trajectory",
+            "scan_speed_m_per_s",
+            10.0,
+            r"scan_speed_m_per_s is in m/s and must be at most 0.1 m/s",
+        ),
+        (
+            "station",
+            "phantom_offset_m",
+            [0.0, 0.0, 10.0],
+            r"phantom_offset_m is in metres, each at most 0.1 m in size",
+        ),
+        (
+            "controller.reference",
+            "force_ref_N",
+            700.0,
+            r"force_ref_N must be at most 50 N; got 700.0",
+        ),
+        (
+            "controller.reference",
+            "force_min_z_N",
+            -700.0,
+            r"force_min_z_N must be >= -50 N",
+        ),
+        # A number as text would stay text, to fail inside the simulation.
+        (
+            "controller.reference",
+            "force_ref_N",
+            "5",
+            r"force_ref_N must be a number; got '5' \(a str\)",
+        ),
+        # A misspelt field set in code would be kept and never read.
+        (
+            "controller.reference",
+            "force_ref",
+            5.0,
+            r"Scenario\.controller\.reference has no field 'force_ref' \(set in "
+            r"code, it would be ignored\); did you mean force_ref_N",
+        ),
+        ("", "controler", None, r"Scenario has no field 'controler'"),
     ],
 )
 def test_a_scenario_changed_in_code_is_checked_before_it_runs(
     part, field, value, message
 ):
-    scenario = synthetic_scenario("cs")
-    setattr(getattr(scenario, part) if part else scenario, field, value)
+    scenario = synthetic_scenario("cf")
+    owner = scenario
+    for name in part.split(".") if part else ():
+        owner = getattr(owner, name)
+    setattr(owner, field, value)
     with pytest.raises(VicDrakeError, match=message):
         run_scan(scenario, duration_s=0.1)
     with pytest.raises(VicDrakeError, match=message):
         MakeScanDiagram(scenario)
+
+
+def test_the_result_keeps_the_scenario_as_it_ran():
+    """A sweep that edits one scenario between runs leaves each result with
+    the values it ran with. A duration given to run_scan is the result's
+    sim_s, not written into the scenario, whose own length sets its
+    breathing's cycles."""
+    scenario = synthetic_scenario("cf")
+    result = run_scan(scenario, duration_s=0.1)
+    scenario.controller.reference.force_ref_N = 5.0
+    assert result.scenario.controller.reference.force_ref_N == 7.0
+    assert result.scenario.duration_s is None and result.sim_s == 0.1
+    # The log carries its controller's limits: CF has no tank, does not aim
+    # at eps_d.
+    limits = result.df.attrs["scan_limits"]
+    assert limits["has_tank"] is False and limits["targets_penetration"] is False
 
 
 @pytest.mark.slow

@@ -157,3 +157,9 @@ def test_a_bare_name_points_to_load_diagram(tmp_path, monkeypatch):
         VicDrakeError, match=r"use vic_drake\.experiments\.load_diagram"
     ):
         load_scenario("nominal_vs_vf_synthetic")
+
+
+@pytest.mark.parametrize("text", ["", "  \n", None])
+def test_empty_yaml_text_is_named(text):
+    with pytest.raises(VicDrakeError, match=r"scenario YAML: the text is empty"):
+        loads_scenario(text)

@@ -5,9 +5,23 @@ Every analysis function takes a DataFrame in this layout (what
 :func:`real_to_canonical`; signals it does not hold become NaN, so real and
 simulated scans go through the same functions.
 
-Sign convention: ``force_sensor_{x,y,z}_N`` are the sensor's reading in W,
-minus the external force on the probe (the force the probe exerts), so
-``force_sensor_z_N`` is negative when pressing into the body.
+Frames, units and signs (W: the robot base frame, z up; SI units):
+
+- ``x_m``, ``y_m``, ``z_m``: the probe tip (the indenter's lowest point) in
+  W; ``x_d_m`` ... ``z_d_m``: the compliance stage's target for it.
+- ``force_sensor_{x,y,z}_N``: the sensor's reading in W, minus the external
+  force on the probe (the force the probe exerts), so ``force_sensor_z_N``
+  is negative when pressing into the body. ``force_ref_z_N`` and
+  ``force_min_z_N`` (the reference and its cap F_min) follow the same
+  convention: negative = pressing.
+- ``force_tissue_z_N``: the simulated tissue's force on the tip along +z,
+  >= 0: the force on the patient (NaN in a rig log).
+- ``penetration_m``: eps = surface height - tip height, positive in the
+  tissue and negative above it; ``surface_z_m``: the surface under the tip.
+  In a simulated log both are the phantom's true ones; in a rig log they
+  are the controller's (its map's).
+- ``stiffness_*``: the compliance stage's stiffness, N/m; ``tank_*``: the
+  energy tank (J, W; CS and CF log its initial state).
 """
 
 import numpy as np
@@ -51,8 +65,19 @@ CANONICAL_COLUMNS = (
 )
 
 
+def check_frame(df, what: str = "a scan log") -> None:
+    """Raises VicDrakeError unless ``df`` is a DataFrame, naming what came."""
+    if not isinstance(df, pd.DataFrame):
+        hint = " (its log is result.df)" if hasattr(df, "df") else ""
+        raise VicDrakeError(
+            f"expected {what} as a pandas DataFrame; got a {type(df).__name__}{hint}"
+        )
+
+
 def require_columns(df: pd.DataFrame, *columns: str) -> None:
-    """Raises VicDrakeError naming the canonical columns df lacks."""
+    """Raises VicDrakeError naming the canonical columns df lacks (or that
+    ``df`` is no DataFrame: e.g. a ScanResult given for its ``.df``)."""
+    check_frame(df)
     missing = [c for c in columns if c not in df.columns]
     if missing:
         raise VicDrakeError(

@@ -11,12 +11,26 @@ import pandas as pd
 
 from vic_drake.analysis.columns import require_columns
 from vic_drake.analysis.contact import contact_mask, pressing_force_N, scan_window
+from vic_drake.errors import VicDrakeError
 from vic_drake.paper import CONTACT_THRESHOLD_N
 
 #: kappa above which a point counts as "over a rib", N/m^beta. The measured
 #: map's soft tissue lies at 2,000-5,500 and its rib lines reach 9,000-10,236;
 #: 7,000 sits in the gap between the two populations of the histogram.
 RIB_KAPPA_THRESHOLD = 7000.0
+
+
+def _window_or(df: pd.DataFrame, mask) -> np.ndarray:
+    """The mask given (one bool per row of ``df``), else the scan window."""
+    if mask is None:
+        return scan_window(df)
+    mask = np.asarray(mask, bool)
+    if mask.shape != (len(df),):
+        raise VicDrakeError(
+            f"mask must hold one bool per row of the log ({len(df)}); got shape "
+            f"{mask.shape}"
+        )
+    return mask
 
 
 def force_rmse_N(df: pd.DataFrame, *, mask=None) -> float:
@@ -28,11 +42,17 @@ def force_rmse_N(df: pd.DataFrame, *, mask=None) -> float:
     where there is no force reference: a CS log (``df.attrs["controller"]``,
     which ``run_scan`` sets), or a reference that is zero over the whole mask
     (CS logs a 0, which would score the pressing force).
+
+    The reference is the one logged, before the QP's cap F_min: where VS-VF's
+    reference asks for more than the cap (over the ribs), the force the cap
+    holds back counts as error. Compare VS-VF with CF on it with that in
+    mind, or pass a ``mask`` that leaves those samples out
+    (``force_ref_z_N >= force_min_z_N``).
     """
     require_columns(df, "force_sensor_z_N", "force_ref_z_N")
     if df.attrs.get("controller") == "cs":
         return float("nan")
-    mask = scan_window(df) if mask is None else np.asarray(mask, bool)
+    mask = _window_or(df, mask)
     ref = df["force_ref_z_N"].to_numpy(float)
     if "qp_fault" in df:
         mask = mask & ~(df["qp_fault"].to_numpy(float) > 0.5)
@@ -45,7 +65,7 @@ def force_rmse_N(df: pd.DataFrame, *, mask=None) -> float:
 
 def force_range_N(df: pd.DataFrame, *, mask=None) -> tuple[float, float]:
     """(min, max) pressing force over the mask (default: scan window), N."""
-    mask = scan_window(df) if mask is None else np.asarray(mask, bool)
+    mask = _window_or(df, mask)
     f = pressing_force_N(df)[mask]
     return (float(f.min()), float(f.max())) if f.size else (float("nan"), float("nan"))
 

@@ -23,6 +23,7 @@ from vic_drake.paper import CONTACT_THRESHOLD_N, CONTROLLERS
 
 __all__ = [
     "CONTROLLERS",  # Re-exported from vic_drake.paper (its old home).
+    "MAX_FORCE_N",
     "MAX_PENETRATION_M",
     "SURFACE_VELOCITY_MODES",
     "ControllerParams",
@@ -35,6 +36,11 @@ __all__ = [
 #: The largest penetration a reference may ask for (eps_max_m, eps_d_m), m:
 #: 5 cm, past any probe's use on soft tissue (the paper's are 8 mm).
 MAX_PENETRATION_M = 0.05
+
+#: The largest pressing force a reference may ask for (force_ref_N,
+#: |force_min_z_N|), N: ultrasonography presses up to ~20 N; past 50 N is a
+#: typo (the rig's safety limit is 15 N).
+MAX_FORCE_N = 50.0
 
 #: Modes of the surface-velocity estimate used in the penetration rate.
 SURFACE_VELOCITY_MODES = ("moving_average", "gradient")
@@ -266,8 +272,17 @@ class ReferenceParams:
             raise VicDrakeError(
                 f"{o}.controller must be one of {list(CONTROLLERS)}; got {self.controller!r}"
             )
-        _positive(o, "force_ref_N", self.force_ref_N)
-        if not check_number(o, "force_min_z_N", self.force_min_z_N) < 0.0:
+        if _positive(o, "force_ref_N", self.force_ref_N) > MAX_FORCE_N:
+            raise VicDrakeError(
+                f"{o}.force_ref_N must be at most {MAX_FORCE_N:g} N; got "
+                f"{self.force_ref_N!r}"
+            )
+        if check_number(o, "force_min_z_N", self.force_min_z_N) < -MAX_FORCE_N:
+            raise VicDrakeError(
+                f"{o}.force_min_z_N must be >= {-MAX_FORCE_N:g} N; got "
+                f"{self.force_min_z_N!r}"
+            )
+        if not self.force_min_z_N < 0.0:
             raise VicDrakeError(
                 f"{o}.force_min_z_N must be < 0 (sensor convention, pressing); "
                 f"got {self.force_min_z_N!r}"

@@ -99,8 +99,8 @@ def disturbance_lifts(t_scan_start_s: float, *, events: int = 2) -> list[Phantom
 def synthetic_scenario(controller: str, *, disturbed: bool = False) -> Scenario:
     """A paper scan on the synthetic phantom with one of the four controllers.
 
-    The target comes down from 12 cm (1.3 cm above the phantom's surface at
-    the start) to z = 0.085 at 1 cm/s, moves 20 cm along -x at 1 cm/s and is
+    The target comes down from 12 cm (2.0 cm above the synthetic chest's
+    surface at the start) to z = 0.085 at 1 cm/s, moves 20 cm along -x at 1 cm/s and is
     raised 4.8 cm; controllers as on the real rig (CS 400 N/m and CF 7 N with
     the FDCC's default z gains, see :data:`CF_FDCC_Z_GAINS`; VS-CF 7 N with R = 0.1, VS-VF eps_d = 8 mm,
     F_min = -9 N, R = 1e-5). ``disturbed`` adds :func:`disturbance_lifts`

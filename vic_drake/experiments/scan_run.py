@@ -8,6 +8,8 @@ and returns the logs as a DataFrame of the canonical columns
 
 from __future__ import annotations
 
+import copy
+import dataclasses
 import math
 import time
 from dataclasses import dataclass
@@ -16,6 +18,7 @@ import pandas as pd
 from pydrake.common import RandomGenerator
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
 
+from vic_drake.analysis.claims import ScanLimits
 from vic_drake.control.watchdog import STUCK_CHANNEL, TRIP_CAUSES, TRIP_TIME
 from vic_drake.errors import VicDrakeError
 from vic_drake.experiments.rig_log import rig_frame
@@ -36,7 +39,8 @@ class ScanResult:
     Attributes:
         df: canonical scan DataFrame (see vic_drake.analysis.columns.CANONICAL_COLUMNS;
             with a lateral breathing part, then ``phantom_x_m``, ``phantom_y_m``).
-        scenario: the exact scenario that ran.
+        scenario: the scenario as it ran (a copy, taken when the run
+            started; a ``duration_s`` given to :func:`run_scan` is ``sim_s``).
         wall_s: wall-clock time of the simulation (excluding building), s.
         sim_s: simulated time, s.
         rtf: real-time factor, sim_s / wall_s (> 1: faster than real time).
@@ -106,6 +110,11 @@ def run_scan(
     duration = scenario.total_duration_s if duration_s is None else float(duration_s)
     if not duration > 0:
         raise VicDrakeError(f"duration_s must be > 0; got {duration_s!r}")
+    # The result keeps the scenario as it ran: the caller's object may change
+    # after (a sweep that edits one scenario). A duration given here is not
+    # written into it (it is the result's sim_s): the scenario's own length
+    # sets its breathing's cycles, so the copy replays the same run.
+    scenario = copy.deepcopy(scenario)
     t_build = time.perf_counter()
     if phantom is None:
         phantom = load_scenario_phantom(scenario, data_dir=data_dir)
@@ -148,6 +157,7 @@ def run_scan(
         source="sim",
         scenario=scenario.name,
         controller=scenario.controller.reference.controller,
+        scan_limits=dataclasses.asdict(ScanLimits.from_controller(scenario.controller)),
     )
     rig = rig_frame(logs, context)
     rig.attrs["beta"] = float(phantom.beta)

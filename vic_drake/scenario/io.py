@@ -61,6 +61,11 @@ def load_scenario(path: str | os.PathLike) -> Scenario:
 
 def loads_scenario(text: str) -> Scenario:
     """Like :func:`load_scenario`, from YAML text."""
+    if not isinstance(text, str) or not text.strip():
+        raise VicDrakeError(
+            f"scenario YAML: the text is empty ({text!r}); give the YAML of a "
+            "Scenario (e.g. open(path).read()), or load_scenario(path) for a file"
+        )
     return _load({"data": text}, "scenario YAML")
 
 

@@ -4,6 +4,12 @@ from dataclasses import dataclass, field
 
 from vic_drake.errors import VicDrakeError, check_number
 
+#: Largest lift-off, m: more is a length typed in mm (48 for 0.048).
+MAX_LIFTOFF_M = 0.2
+#: Largest approach and scan speed, m/s (the rig scanned at 0.01): more is
+#: a speed typed in mm/s.
+MAX_SPEED_M_PER_S = 0.1
+
 
 @dataclass
 class TrajectoryConfig:
@@ -68,16 +74,22 @@ class TrajectoryConfig:
         o = "TrajectoryConfig"
         for name in ("start_x_m", "end_x_m", "y_m", "approach_z_m", "target_z_m"):
             check_number(o, name, getattr(self, name))
-        for name in (
-            "start_delay_s",
-            "dwell_s",
-            "end_dwell_s",
-            "liftoff_height_m",
-            "liftoff_s",
-        ):
+        for name in ("start_delay_s", "dwell_s", "end_dwell_s", "liftoff_s"):
             check_number(o, name, getattr(self, name), low=0.0)
+        if check_number(o, "liftoff_height_m", self.liftoff_height_m, low=0.0) > (
+            MAX_LIFTOFF_M
+        ):
+            raise VicDrakeError(
+                f"{o}.liftoff_height_m is in metres and must be at most "
+                f"{MAX_LIFTOFF_M:g} m; got {self.liftoff_height_m!r} (0.05 is 5 cm)"
+            )
         for name in ("approach_speed_m_per_s", "scan_speed_m_per_s"):
-            check_number(o, name, getattr(self, name), low=0.0, low_open=True)
+            value = check_number(o, name, getattr(self, name), low=0.0, low_open=True)
+            if value > MAX_SPEED_M_PER_S:
+                raise VicDrakeError(
+                    f"{o}.{name} is in m/s and must be at most "
+                    f"{MAX_SPEED_M_PER_S:g} m/s; got {value!r} (0.01 is 1 cm/s)"
+                )
         if self.approach_z_m < self.target_z_m:
             raise VicDrakeError(
                 f"{o}.approach_z_m ({self.approach_z_m!r}) must be >= target_z_m "

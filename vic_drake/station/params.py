@@ -28,6 +28,10 @@ from vic_drake.tissue.relaxation import (
     tissue_relaxation,
 )
 
+#: Largest shift of the phantom from its place on each axis, m: more moves
+#: it off the scan, or is a length typed in mm.
+MAX_PHANTOM_OFFSET_M = 0.1
+
 #: Drake's discrete contact solvers the station supports.
 CONTACT_APPROXIMATIONS = ("sap", "lagged")
 
@@ -221,7 +225,13 @@ class StationParams:
                 f"StationParams.sensor_noise_std_N must be >= 0, got {self.sensor_noise_std_N!r}"
             )
         _vec(self.sensor_bias_N, 3, "sensor_bias_N")
-        _vec(self.phantom_offset_m, 3, "phantom_offset_m")
+        offset = _vec(self.phantom_offset_m, 3, "phantom_offset_m")
+        if np.any(np.abs(offset) > MAX_PHANTOM_OFFSET_M):  # E.g. 10 (mm) for 0.01.
+            raise VicDrakeError(
+                "StationParams.phantom_offset_m is in metres, each at most "
+                f"{MAX_PHANTOM_OFFSET_M:g} m in size; got {self.phantom_offset_m!r} "
+                "(0.01 is 1 cm)"
+            )
         lag = self.sensor_lag_samples
         if isinstance(lag, bool) or not isinstance(lag, (int, np.integer)) or lag < 0:
             raise VicDrakeError(

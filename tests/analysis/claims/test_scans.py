@@ -188,13 +188,25 @@ def test_c7_passes_and_each_check_can_fail():
 
 
 def test_scan_limits_are_the_controllers_settings():
-    from vic_drake.control.params import ControllerParams
+    import dataclasses
+
+    from vic_drake.control.params import ControllerParams, real_controller_params
 
     p = ControllerParams()
     limits = C.ScanLimits()
-    assert limits == C.ScanLimits.from_controller(p)
+    # The defaults are the default controller's; whether it aims at eps_d is
+    # left open (None: a log of an unknown controller is scored on it).
+    assert limits.targets_penetration is None
+    assert dataclasses.replace(limits, targets_penetration=False) == (
+        C.ScanLimits.from_controller(p)
+    )
     assert limits.k_min_z_N_per_m == p.qp.stiffness_min_N_per_m[2]
     assert limits.power_max_W == -p.tank.power_limit_W
+    aims = {
+        c: C.ScanLimits.from_controller(real_controller_params(c)).targets_penetration
+        for c in ("cs", "cf", "vs-cf", "vs-vf")
+    }
+    assert aims == {"cs": False, "cf": False, "vs-cf": False, "vs-vf": True}
 
 
 def test_controllers_without_a_tank_have_nan_tank_metrics():

@@ -113,7 +113,7 @@ def test_a_resume_with_other_code_is_refused_before_any_work(tmp_path, no_cluste
     from vic_drake.provenance import code_id
 
     out = tmp_path / "c"
-    other = "0123456789ab drake 1.40.0 py 3.10.0"
+    other = "vic_drake 0.1.0 source 0123456789ab, drake 1.40.0, python 3.10.0"
     before = _stored_campaign(out, [code_id(), other, other, None])
     with pytest.raises(VicDrakeError) as err:
         run_campaign(SMOKE, out, workers=1, resume=True)
@@ -135,11 +135,11 @@ def test_a_finished_campaign_of_other_code_is_summarised_again(tmp_path, no_clus
     """With no run left to do, a resume mixes nothing: it writes the summary
     of the stored rows (no cluster needed), naming their code."""
     out = tmp_path / "done"
-    other = "0123456789ab drake 1.40.0 py 3.10.0"
+    other = "vic_drake 0.1.0 source 0123456789ab, drake 1.40.0, python 3.10.0"
     _stored_campaign(out, [other] * 16)
     summary = run_campaign(SMOKE, out, workers=1, resume=True)
     assert summary["code_ids"] == {other: 16} and summary["session_runs"] == 0
-    assert f"Code: {other}." in (out / "summary.html").read_text()
+    assert f"Computed by {other}." in (out / "summary.html").read_text()
 
 
 def test_the_summary_counts_the_rows_per_code():
@@ -156,7 +156,7 @@ def test_the_summary_counts_the_rows_per_code():
     )
     one = summary_dict(spec, rows.assign(code_id="a"))
     assert one["code_ids"] == {"a": 3}
-    assert "Code: a." in summary_html(Path("."), spec, rows, one)
+    assert "Computed by a." in summary_html(Path("."), spec, rows, one)
     assert "code" not in _human({**_result(3), "code_ids": one["code_ids"]})
 
 

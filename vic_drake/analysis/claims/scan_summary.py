@@ -15,6 +15,7 @@ from vic_drake.analysis.claims.thresholds import (
     C7_K_MIN_TOL_N_PER_M,
     C7_LOSS_SETTLE_S,
 )
+from vic_drake.analysis.columns import check_frame
 from vic_drake.analysis.contact import (
     CONTACT_THRESHOLD_N,
     SCAN_HEIGHT_TOL_M,
@@ -47,6 +48,10 @@ class ScanLimits:
         eps_d_m: VS-VF's desired penetration.
         has_tank: the controller has an energy tank (VS-CF, VS-VF); without
             one (CS, CF) the tank metrics are NaN.
+        targets_penetration: the controller's reference aims at eps_d
+            (VS-VF); for the others the penetration error against eps_d
+            means nothing and is not given. None: the controller is not
+            known (a rig log scored on the defaults): given.
     """
 
     k_min_z_N_per_m: float = _default(lambda p: p.qp.stiffness_min_N_per_m[2])
@@ -54,6 +59,7 @@ class ScanLimits:
     power_max_W: float = _default(lambda p: -p.tank.power_limit_W)
     eps_d_m: float = _default(lambda p: p.reference.eps_d_m)
     has_tank: bool = True
+    targets_penetration: bool | None = None
 
     @classmethod
     def from_controller(cls, params: ControllerParams) -> "ScanLimits":
@@ -64,6 +70,7 @@ class ScanLimits:
             power_max_W=float(-params.tank.power_limit_W),
             eps_d_m=float(params.reference.eps_d_m),
             has_tank=controller_has_tank(params.reference),
+            targets_penetration=params.reference.controller == "vs-vf",
         )
 
 
@@ -81,8 +88,9 @@ def scan_metrics(
 
     Args:
         df: canonical scan DataFrame; optional columns are used where present.
-        limits: controller settings (K_min, T_min, P_max, eps_d); default
-            ScanLimits().
+        limits: controller settings (K_min, T_min, P_max, eps_d); default:
+            the log's own (``df.attrs["scan_limits"]``, which ``run_scan``
+            sets), else ScanLimits() (the real controller's).
         settle_s: seconds after first contact excluded from the scan window.
         end_s: length of the final segment checked for lift-off, s.
 
@@ -97,7 +105,18 @@ def scan_metrics(
         and tank metrics (C7; the tank's NaN for a controller without one,
         ``limits.has_tank`` False).
     """
-    limits = ScanLimits() if limits is None else limits
+    check_frame(df)
+    if limits is None:
+        # A simulated log carries its controller's limits (run_scan sets
+        # them); a rig log is scored against the real controller's.
+        stored = df.attrs.get("scan_limits")
+        limits = ScanLimits(**stored) if stored else ScanLimits()
+    if not isinstance(limits, ScanLimits):
+        raise VicDrakeError(
+            "scan_metrics: limits must be a ScanLimits "
+            "(ScanLimits.from_controller(scenario.controller)); got a "
+            f"{type(limits).__name__}"
+        )
     missing = [c for c in REQUIRED_SCAN_COLUMNS if c not in df.columns]
     if missing:
         raise VicDrakeError(
@@ -161,9 +180,10 @@ def _force_cap_metrics(df, w, f, limits: ScanLimits) -> dict:
     on = w & (ref > cap)
     out = {"n_off_ribs": int(off.sum()), "n_on_ribs": int(on.sum())}
     if off.sum() >= 10:
-        err = np.abs(pen[off] - limits.eps_d_m)
         out["penetration_off_ribs_median_m"] = float(np.median(pen[off]))
-        out["penetration_error_off_ribs_median_m"] = float(np.median(err))
+        if limits.targets_penetration is not False:  # Only VS-VF aims at eps_d.
+            err = np.abs(pen[off] - limits.eps_d_m)
+            out["penetration_error_off_ribs_median_m"] = float(np.median(err))
     if on.sum() >= 10:
         out["force_on_ribs_p99_N"] = float(np.percentile(f[on], 99))
         out["force_cap_N"] = float(np.median(cap[on]))

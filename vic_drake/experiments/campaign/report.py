@@ -195,7 +195,7 @@ def _header(spec: CampaignSpec, summary: dict) -> list[str]:
     )
     codes = summary.get("code_ids", {})
     if len(codes) == 1:
-        parts.append(f"<p>Code: {html.escape(next(iter(codes)))}.</p>")
+        parts.append(f"<p>Computed by {html.escape(next(iter(codes)))}.</p>")
     elif codes:
         mixed = "; ".join(f"{n} by {html.escape(c)}" for c, n in codes.items())
         parts.append(

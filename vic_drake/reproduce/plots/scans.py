@@ -207,11 +207,12 @@ def plot_fig6(
     *,
     save_path=None,
 ) -> Figure:
-    """Fig. 6: nominal VS-CF and VS-VF (force with F_ref and F_min, K_z,
-    penetration, tank), one column per controller.
+    """Fig. 6: nominal scans (force with F_ref and F_min, K_z, penetration,
+    tank), one column per controller. The paper shows VS-CF and VS-VF; any
+    of the four controllers may be given.
 
     Args:
-        sims: {"vs-cf": df, "vs-vf": df} simulated scans (any subset, >= 1).
+        sims: {controller: df} simulated scans (e.g. "vs-cf", "vs-vf"; >= 1).
         reals: same keys, real logs in the canonical layout (optional).
     """
     if not sims:
