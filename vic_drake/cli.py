@@ -13,10 +13,11 @@ import argparse
 import importlib
 import os
 import sys
+import warnings
 
 from vic_drake import __version__
 from vic_drake.ctrl_c import hold_ctrl_c, release_ctrl_c
-from vic_drake.errors import VicDrakeError
+from vic_drake.errors import VicDrakeError, VicDrakeWarning
 from vic_drake.malloc_tuning import reexec_tuned
 from vic_drake.paths import WITHOUT_DATA_SYNTHETIC, check_data_dir
 
@@ -178,8 +179,20 @@ def _interrupted_import(exc: ImportError) -> bool:
     return False
 
 
+def _show_warning(message, category, filename, lineno, file=None, line=None):
+    """vic_drake's own warnings as one line, others as Python shows them."""
+    if issubclass(category, VicDrakeWarning):
+        print(f"vic-drake: warning: {message}", file=file or sys.stderr)
+    else:
+        _python_show_warning(message, category, filename, lineno, file, line)
+
+
+_python_show_warning = warnings.showwarning
+
+
 def _run(argv: list[str] | None) -> int:
     """Parses the command line and runs its command; errors as exit status 2."""
+    warnings.showwarning = _show_warning
     parser = build_parser()
     _check_command_name(parser, sys.argv[1:] if argv is None else argv)
     args, extras = parser.parse_known_args(argv)

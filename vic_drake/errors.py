@@ -17,6 +17,11 @@ class DataNotFoundError(VicDrakeError, FileNotFoundError):
     """The paper's measurements (or one file of them) are not where expected."""
 
 
+class VicDrakeWarning(UserWarning):
+    """Something a run does that its user may not expect, though it runs
+    (the command line prints it as "vic-drake: warning: ...")."""
+
+
 def check_number(
     owner: str, name: str, value, *, low=None, low_open=False, high=None
 ) -> float:

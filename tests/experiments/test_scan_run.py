@@ -173,3 +173,33 @@ def test_a_disturbed_real_logs_scenario_starts_without_an_impact(data_dir):
     scenario = load_diagram("real_test_force_control_dist")
     df = run_scan(scenario, duration_s=0.5, data_dir=data_dir).df
     assert df["force_sensor_z_N"].abs().max() < 8.0
+
+
+def test_a_path_past_the_phantom_is_warned():
+    """Past its footprint a phantom holds its edge's values: tissue nobody
+    measured. run_scan says so; the shipped paths stay on it."""
+    import io
+
+    from vic_drake.cli import _show_warning
+    from vic_drake.errors import VicDrakeWarning
+    from vic_drake.experiments.scan_run import path_outside_phantom
+    from vic_drake.tissue import SyntheticChestPhantom
+
+    phantom = SyntheticChestPhantom()
+    assert path_outside_phantom(synthetic_scenario("cf"), phantom) is None
+    scenario = synthetic_scenario("cf")
+    scenario.trajectory.end_x_m = scenario.trajectory.end_x_m - 0.3
+    message = path_outside_phantom(scenario, phantom)
+    assert "passes the phantom's footprint by" in message and "mm in x" in message
+    with pytest.warns(VicDrakeWarning, match="passes the phantom's footprint"):
+        run_scan(scenario, phantom=phantom, duration_s=0.02)
+    # The phantom moved by the station's offset moves its footprint: the
+    # shipped path (x from 0.036 to -0.164 m; the chest from 0.105 to -0.225)
+    # leaves it when the chest moves 9 cm towards +x.
+    shipped = synthetic_scenario("cf")
+    shipped.station.phantom_offset_m = [0.09, 0.0, 0.0]
+    assert "by 29 mm in x" in path_outside_phantom(shipped, phantom)
+    # The command line prints it as one line.
+    out = io.StringIO()
+    _show_warning(message, VicDrakeWarning, "x.py", 1, file=out)
+    assert out.getvalue() == f"vic-drake: warning: {message}\n"

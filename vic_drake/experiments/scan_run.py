@@ -12,6 +12,7 @@ import copy
 import dataclasses
 import math
 import time
+import warnings
 from dataclasses import dataclass
 
 import pandas as pd
@@ -20,7 +21,7 @@ from pydrake.systems.analysis import ApplySimulatorConfig, Simulator
 
 from vic_drake.analysis.claims import ScanLimits
 from vic_drake.control.watchdog import STUCK_CHANNEL, TRIP_CAUSES, TRIP_TIME
-from vic_drake.errors import VicDrakeError
+from vic_drake.errors import VicDrakeError, VicDrakeWarning
 from vic_drake.experiments.rig_log import rig_frame
 from vic_drake.experiments.scan_diagram import (
     MakeScanDiagram,
@@ -30,6 +31,43 @@ from vic_drake.experiments.scan_diagram import (
 )
 from vic_drake.experiments.scan_logs import logs_to_frame
 from vic_drake.scenario import Scenario
+
+#: How far the target's path may pass the phantom's footprint before
+#: :func:`run_scan` warns, m (the shipped scans end 5 mm past the measured
+#: map's edge).
+PATH_OUTSIDE_TOLERANCE_M = 0.01
+
+
+def path_outside_phantom(scenario: Scenario, phantom) -> str | None:
+    """What the target's (x, y) path does past the phantom's footprint
+    (``phantom.bounds``, moved by ``station.phantom_offset_m``), beyond
+    :data:`PATH_OUTSIDE_TOLERANCE_M`; None if it stays on it.
+
+    Past the footprint a phantom holds its edge's surface, kappa and lambda,
+    so a scan there scores tissue that was never measured.
+    """
+    traj = scenario.trajectory
+    if traj.waypoints:
+        xs = [float(r[1]) for r in traj.waypoints]
+        ys = [float(r[2]) for r in traj.waypoints]
+    else:
+        xs, ys = [float(traj.start_x_m), float(traj.end_x_m)], [float(traj.y_m)]
+    ox, oy = (float(v) for v in scenario.station.phantom_offset_m[:2])
+    x0, x1, y0, y1 = phantom.bounds
+    x0, x1, y0, y1 = x0 + ox, x1 + ox, y0 + oy, y1 + oy
+    past = {
+        "x": max(x0 - min(xs), max(xs) - x1),
+        "y": max(y0 - min(ys), max(ys) - y1),
+    }
+    far = {axis: d for axis, d in past.items() if d > PATH_OUTSIDE_TOLERANCE_M}
+    if not far:
+        return None
+    parts = ", ".join(f"{1e3 * d:.0f} mm in {axis}" for axis, d in far.items())
+    return (
+        f"{scenario.name}: the target's path passes the phantom's footprint by "
+        f"{parts} (x {x0:.4f} to {x1:.4f} m, y {y0:.4f} to {y1:.4f} m); past it "
+        "the phantom holds its edge's surface, kappa and lambda"
+    )
 
 
 @dataclass
@@ -118,6 +156,9 @@ def run_scan(
     t_build = time.perf_counter()
     if phantom is None:
         phantom = load_scenario_phantom(scenario, data_dir=data_dir)
+    outside = path_outside_phantom(scenario, phantom)
+    if outside:
+        warnings.warn(outside, VicDrakeWarning, stacklevel=2)
     diagram, logs = MakeScanDiagram(
         scenario,
         phantom=phantom,
@@ -175,4 +216,9 @@ def run_scan(
     )
 
 
-__all__ = ["ScanResult", "run_scan"]
+__all__ = [
+    "PATH_OUTSIDE_TOLERANCE_M",
+    "ScanResult",
+    "path_outside_phantom",
+    "run_scan",
+]
