@@ -6,7 +6,7 @@ import shutil
 import pytest
 
 from vic_drake.errors import VicDrakeError
-from vic_drake.experiments.dask_cluster import check_worker_code
+from vic_drake.experiments.dask_cluster import check_workers, worker_status
 from vic_drake.provenance import CODE_ID_DIGITS, PACKAGE_DIR, code_id, source_hash
 
 
@@ -40,24 +40,40 @@ def test_the_code_id_names_the_source_drake_and_python():
 
 
 class _Client:
-    def __init__(self, ids: dict):
-        self.ids = ids
+    def __init__(self, ids: dict, problems: dict | None = None):
+        self.status = {a: (c, (problems or {}).get(a, "")) for a, c in ids.items()}
 
     def run(self, function):
-        assert function is code_id  # Each worker computes its own.
-        return self.ids
+        assert function is worker_status  # Each worker reports its own.
+        return self.status
 
 
 def test_workers_with_other_code_are_refused_by_name():
     here = code_id()
-    check_worker_code(_Client({"tcp://a:1": here, "tcp://b:2": here}))
+    check_workers(_Client({"tcp://a:1": here, "tcp://b:2": here}))
     other = "vic_drake 0.1.0 source 0123456789ab, drake 1.40.0, python 3.10.0"
     with pytest.raises(VicDrakeError) as err:
-        check_worker_code(_Client({"tcp://a:1": here, "tcp://b:2": other}))
+        check_workers(_Client({"tcp://a:1": here, "tcp://b:2": other}))
     text = str(err.value)
     assert text.startswith("1 Dask worker(s) run other code than this process")
     assert f"tcp://b:2: {other}" in text and "tcp://a:1" not in text
     assert here in text and "install the same vic_drake, Drake and Python" in text
     many = {f"tcp://w:{i}": other for i in range(5)}
     with pytest.raises(VicDrakeError, match=r"^5 Dask worker.*\(and 2 more\)"):
-        check_worker_code(_Client(many))
+        check_workers(_Client(many))
+
+
+def test_a_worker_that_would_fail_every_run_is_refused(monkeypatch):
+    """A worker whose VIC_DRAKE_ALLOCATOR is bad fails each run at once, so
+    it takes the whole queue: refused when the cluster is reached."""
+    monkeypatch.setenv("VIC_DRAKE_ALLOCATOR", "bogus")
+    code, problem = worker_status()
+    assert code == code_id() and "VIC_DRAKE_ALLOCATOR='bogus'" in problem
+    monkeypatch.delenv("VIC_DRAKE_ALLOCATOR")
+    assert worker_status() == (code_id(), "")
+    here = code_id()
+    client = _Client({"tcp://a:1": here, "tcp://b:2": here}, {"tcp://b:2": problem})
+    with pytest.raises(VicDrakeError) as err:
+        check_workers(client)
+    assert str(err.value).startswith("1 Dask worker(s) cannot run scans: tcp://b:2: ")
+    assert "mend their environment" in str(err.value)

@@ -31,9 +31,10 @@ def _jsonable(value):
     return value
 
 
-def to_json(result: dict) -> str:
-    """JSON text of a result dict (numpy scalars converted, NaN/inf -> null)."""
-    return json.dumps(_jsonable(result), indent=2, allow_nan=False)
+def to_json(result: dict, *, indent: int | None = 2) -> str:
+    """JSON text of a result dict (numpy scalars converted, NaN/inf -> null;
+    ``indent`` None: one line)."""
+    return json.dumps(_jsonable(result), indent=indent, allow_nan=False)
 
 
 __all__ = ["to_json"]

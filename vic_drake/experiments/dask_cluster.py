@@ -149,12 +149,33 @@ def quiet_logs(quiet: bool):
             lg.setLevel(level)
 
 
-def check_worker_code(client) -> None:
-    """Refuses a cluster whose workers run other code than this process
-    (:func:`vic_drake.provenance.code_id`: vic_drake's source, Drake and
-    Python): their results would not be this code's."""
+def worker_status() -> tuple[str, str]:
+    """(code_id, problem) of the process it runs in: what a Dask worker
+    reports to :func:`check_workers` (problem "" when it can run scans)."""
+    try:
+        allocator(os.environ)
+    except ValueError as exc:
+        return code_id(), str(exc)
+    return code_id(), ""
+
+
+def check_workers(client) -> None:
+    """Refuses a cluster whose workers cannot run this process's scans:
+    other code (:func:`vic_drake.provenance.code_id`: vic_drake's source,
+    Drake and Python), whose results would not be this code's, or a setting
+    that fails every run at once (a bad ``VIC_DRAKE_ALLOCATOR``), which
+    would drain the queue into error rows."""
     here = code_id()
-    other = {addr: c for addr, c in client.run(code_id).items() if c != here}
+    status = client.run(worker_status)
+    broken = {a: p for a, (_, p) in status.items() if p}
+    other = {a: c for a, (c, p) in status.items() if c != here and not p}
+    if broken:
+        shown = "; ".join(f"{a}: {p}" for a, p in sorted(broken.items())[:3])
+        raise VicDrakeError(
+            f"{len(broken)} Dask worker(s) cannot run scans: {shown}"
+            + (f" (and {len(broken) - 3} more)" if len(broken) > 3 else "")
+            + ". Every run given to them would fail: mend their environment"
+        )
     if other:
         shown = "; ".join(f"{a}: {c}" for a, c in sorted(other.items())[:3])
         more = f" (and {len(other) - 3} more)" if len(other) > 3 else ""
@@ -169,7 +190,7 @@ def check_worker_code(client) -> None:
 def dask_session(workers: int | None, scheduler: str | None):
     """Yields ``(client, futures)``: a client of :func:`dask_client` and a
     dict for the caller's futures, once every worker is found to run this
-    process's code (:func:`check_worker_code`). On leaving (also on Ctrl-C, which
+    process's code and can run scans (:func:`check_workers`). On leaving (also on Ctrl-C, which
     :func:`ctrl_c_stops_once` turns into one KeyboardInterrupt) the futures
     are cancelled and the client and a local cluster closed, with Dask's
     warnings about the cancelled work hidden after Ctrl-C."""
@@ -178,7 +199,7 @@ def dask_session(workers: int | None, scheduler: str | None):
     with ctrl_c_stops_once():
         client, cluster = dask_client(workers, scheduler)
         try:
-            check_worker_code(client)
+            check_workers(client)
             yield client, futures
         except KeyboardInterrupt:
             interrupted = True
@@ -306,10 +327,11 @@ def add_cluster_arguments(
 __all__ = [
     "add_cluster_arguments",
     "check_scheduler",
-    "check_worker_code",
+    "check_workers",
     "ctrl_c_stops_once",
     "dask_client",
     "dask_session",
     "map_on_cluster",
     "quiet_logs",
+    "worker_status",
 ]

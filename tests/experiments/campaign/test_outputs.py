@@ -88,6 +88,19 @@ def test_resume_without_a_campaign_says_so_and_starts(tmp_path, no_cluster):
     assert lines == [f"nothing to resume: {str(out)!r} is empty; starting the campaign"]
 
 
+def _texts() -> dict:
+    """SMOKE's spec and base scenario as a campaign folder stores them."""
+    from vic_drake.experiments.campaign.spec import load_campaign_spec
+    from vic_drake.paths import CAMPAIGN_SPEC_FILE
+    from vic_drake.scenario import dumps_scenario, load_scenario
+
+    spec, base = load_campaign_spec(SMOKE)
+    return {
+        CAMPAIGN_SPEC_FILE: engine._spec_text(spec, base),
+        engine.CAMPAIGN_BASE_FILE: dumps_scenario(load_scenario(base)),
+    }
+
+
 def _stored_campaign(out: Path, codes) -> list[str]:
     """A campaign folder of SMOKE's spec with one stored row per code in
     ``codes`` (None: a row without one); returns the listing."""
@@ -96,10 +109,11 @@ def _stored_campaign(out: Path, codes) -> list[str]:
     from vic_drake.scenario import load_scenario
 
     spec, base = load_campaign_spec(SMOKE)
-    engine._create(out, engine._spec_text(spec, base))
+    engine._create(out, _texts())
     plans = plan_campaign(spec, load_scenario(base))
     for plan, code in zip(plans, codes):
         row = failed_row(plan, "a stand-in row", wall_s=0.0)
+        row["status"], row["error"] = "ok", ""
         row.pop("code_id")
         if code is not None:
             row["code_id"] = code
@@ -140,6 +154,63 @@ def test_a_finished_campaign_of_other_code_is_summarised_again(tmp_path, no_clus
     summary = run_campaign(SMOKE, out, workers=1, resume=True)
     assert summary["code_ids"] == {other: 16} and summary["session_runs"] == 0
     assert f"Computed by {other}." in (out / "summary.html").read_text()
+
+
+def test_a_resume_with_another_base_scenario_or_spec_shows_what_differs(
+    tmp_path, no_cluster
+):
+    """The base scenario's contents count, not only its path: a base file
+    edited between the start and the resume is refused, with the lines."""
+    from vic_drake.provenance import code_id
+
+    out = tmp_path / "c"
+    before = _stored_campaign(out, [code_id()] * 2)
+    base = out / engine.CAMPAIGN_BASE_FILE
+    base.write_text(base.read_text().replace("seed: 0", "seed: 5", 1))
+    with pytest.raises(VicDrakeError) as err:
+        run_campaign(SMOKE, out, workers=1, resume=True)
+    text = str(err.value)
+    assert "holds another base scenario (base_scenario.yaml); --resume" in text
+    assert "Stored (-) and now (+): -" in text and "seed: 5" in text
+    assert _listing(out) == before
+    spec = out / "spec.yaml"
+    base.unlink()  # A folder from before bases were kept: not checked.
+    spec.write_text(spec.read_text().replace("runs: 16", "runs: 8"))
+    with pytest.raises(
+        VicDrakeError, match=r"another campaign spec .*-runs: 8; \+runs: 16"
+    ):
+        run_campaign(SMOKE, out, workers=1, resume=True)
+
+
+def test_a_resume_runs_the_failed_runs_again(tmp_path, no_cluster):
+    """A run that failed with an error (a worker lost, a broken node) has no
+    result: a resume runs it again; an ok run it keeps."""
+    from vic_drake.provenance import code_id
+
+    out = tmp_path / "c"
+    _stored_campaign(out, [code_id()] * 3)
+    for name in ("run_00001", "run_00002"):
+        row = json.loads((out / "rows" / f"{name}.json").read_text())
+        row.update(status="error", error="its process exited with status -9")
+        (out / "rows" / f"{name}.json").write_text(json.dumps(row))
+    lines = []
+    with pytest.raises(_NoCluster):
+        run_campaign(SMOKE, out, workers=1, resume=True, progress=lines.append)
+    assert lines == [
+        f"2 runs of {str(out)!r} failed with an error before: running them again"
+    ]
+    assert engine._check_out(out, _texts(), _plans(), True, lambda _: None) == {
+        "run_00000"
+    }
+
+
+def _plans():
+    from vic_drake.experiments.campaign.plan import plan_campaign
+    from vic_drake.experiments.campaign.spec import load_campaign_spec
+    from vic_drake.scenario import load_scenario
+
+    spec, base = load_campaign_spec(SMOKE)
+    return plan_campaign(spec, load_scenario(base))
 
 
 def test_the_summary_counts_the_rows_per_code():
@@ -467,3 +538,36 @@ def test_runs_that_never_touched_are_counted_in_the_table_and_the_console(tmp_pa
     vs = next(line.split() for line in text.splitlines() if line.startswith("vs-cf "))
     assert vs[1:4] == ["2", "1", "7.80"]
     assert "15 N" in text.split("wd stops", 1)[1]  # The legend under the table.
+
+
+def test_the_page_lists_what_varies_and_replays_from_any_folder(tmp_path, monkeypatch):
+    """The factors as the spec draws them; the worst runs' replay commands
+    with the folder made absolute (a relative --out worked only from where
+    the campaign ran)."""
+    from vic_drake.experiments.campaign.spec import Factor
+
+    spec = CampaignSpec(
+        runs=3,
+        factors=[
+            Factor(field="controller", dist="grid", labels=["cs", "cf", "vs-vf"]),
+            Factor(field="variations.sensor_faults.noise_std_N", low=0.2, high=1.0),
+            Factor(
+                field="variations.sensor_faults.bias_N[2]",
+                dist="normal",
+                std=1.0,
+                low=-3.0,
+                high=3.0,
+            ),
+        ],
+    )
+    rows = _rows()
+    summary = {**_result(3, finished=3), "runs": 3}
+    monkeypatch.chdir(tmp_path)
+    page = summary_html(Path("rel") / "camp", spec, rows, summary)
+    assert "<h2>What varies</h2>" in page
+    assert "grid: cs, cf, vs-vf (each round of runs has every one)" in page
+    assert "uniform from 0.2 to 1" in page
+    assert "normal, mean 0, std 1, clipped to [-3, 3]" in page
+    absolute = tmp_path / "rel" / "camp" / "scenarios"
+    assert f"vic-drake scan {absolute}/run_" in page
+    assert "vic-drake scan rel/" not in page

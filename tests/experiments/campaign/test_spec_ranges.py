@@ -154,3 +154,64 @@ def test_the_command_says_it_in_one_line_and_writes_nothing(tmp_path, capsys):
     assert err.startswith("vic-drake: error: campaign spec") and err.count("\n") == 1
     assert which in err and message in err and "Traceback" not in err
     assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    "factor, message",
+    [
+        # A misspelt field: the fields there and the close name, not "narrow
+        # the range".
+        (
+            {
+                "field": "variations.motion.breathing.amplitud_m",
+                "dist": "uniform",
+                "low": 0.005,
+                "high": 0.01,
+            },
+            r"factors\[0\]: factor 'variations\.motion\.breathing\.amplitud_m': "
+            r"variations\.motion\.breathing has no field 'amplitud_m'; did you mean "
+            r"amplitude_m",
+        ),
+        # An integer field drawn from a range: rounded in the run, unrounded in
+        # the row, its levels drawn unevenly.
+        (
+            {
+                "field": f"{FAULTS}.stuck_channel",
+                "dist": "uniform",
+                "low": -1,
+                "high": 2,
+            },
+            r"factors\[0\] \(variations\.sensor_faults\.stuck_channel\) is an "
+            r"integer field: draw it with dist grid or choice",
+        ),
+        (
+            {"field": "seed", "dist": "normal", "mean": 5, "std": 1},
+            r"factors\[0\] \(seed\) is an integer field",
+        ),
+        # The same cell twice in a grid.
+        (
+            {"field": "controller", "dist": "grid", "labels": ["cs", "cs"]},
+            r"the grid lists 'cs' more than once",
+        ),
+    ],
+)
+def test_a_factor_that_cannot_be_what_it_says_is_refused(tmp_path, factor, message):
+    with pytest.raises(VicDrakeError, match=message):
+        load_campaign_spec(_spec(tmp_path, [factor]))
+
+
+def test_an_integer_field_from_levels_and_a_weighted_choice_are_fine(tmp_path):
+    factors = [
+        {"field": f"{FAULTS}.stuck_channel", "dist": "choice", "values": [-1, 2]},
+        {"field": "controller", "dist": "choice", "labels": ["cs", "cs", "vs-vf"]},
+    ]
+    load_campaign_spec(_spec(tmp_path, factors))
+
+
+def test_a_duration_far_past_the_base_scenario_is_refused(tmp_path):
+    path = _spec(tmp_path, [{"field": "controller", "dist": "grid", "labels": ["cs"]}])
+    path.write_text(path.read_text().replace("duration_s: 4.0", "duration_s: 100000"))
+    with pytest.raises(
+        VicDrakeError, match=r"duration_s 100000 s is far beyond the base scenario"
+    ):
+        load_campaign_spec(path)

@@ -107,6 +107,38 @@ def test_paired_arms_compare_run_for_run():
     assert c["exceedance"]["only_first"] == 1 and c["exceedance"]["only_second"] == 0
 
 
+def test_paired_arms_pair_within_the_other_grid_factors_cells():
+    """Two grid factors (the arm, a breathing amplitude) over 3 rounds: 6
+    pairs, each arm's run against the other arm's at the same amplitude. A
+    failed run drops its pair alone (it had made the arms' lengths differ:
+    a broadcast error and no summary)."""
+    rows = []
+    for index in range(12):
+        rnd, cell = divmod(index, 4)
+        arm, amplitude = ("cs", "vs-vf")[cell % 2], (0.005, 0.015)[cell // 2]
+        rows.append(
+            {
+                "index": index,
+                "status": "ok",
+                "factor.controller": arm,
+                "factor.variations.motion.breathing.amplitude_m": amplitude,
+                "factor.variations.sensor_faults.noise_std_N": 0.1 * rnd,  # Drawn.
+                # vs-vf 1 N above cs at the small amplitude, 3 N at the large.
+                "peak_force_N": 8.0 + rnd + (arm == "vs-vf") * (1 + 2 * (cell // 2)),
+                "contact_loss_s": 0.0,
+            }
+        )
+    table = pd.DataFrame(rows)
+    (c,) = paired_arms(table, 4, 15.0)
+    assert c["pairs"] == 6
+    assert c["peak_force_diff_N_p10"] == pytest.approx(1.0)
+    assert c["peak_force_diff_N_p90"] == pytest.approx(3.0)
+    table.loc[5, "status"] = "error"  # Round 1, vs-vf at the small amplitude.
+    (c,) = paired_arms(table, 4, 15.0)
+    assert c["pairs"] == 5
+    assert c["contact_loss"]["both"] == 0
+
+
 def test_paired_arms_need_a_grid_of_two_or_more():
     assert paired_arms(_paired_rows(), 0, 15.0) == []
     assert paired_arms(_paired_rows().iloc[:0], 2, 15.0) == []
@@ -145,7 +177,9 @@ def test_few_runs_per_controller_are_too_few_for_factor_effects():
     }
 
 
-def test_a_numeric_factor_with_two_values_is_numeric():
+def test_a_numeric_factor_with_two_values_is_summarised_per_value():
+    """A grid or choice of two numbers: the median per value (thirds of two
+    values would be the values themselves), the keys written short."""
     rows = _small_rows(3)
     # Two values only (as a grid of two), each controller's 0.005, 0.010, 0.005.
     rows["factor.amp"] = [0.005] * 4 + [0.010] * 4 + [0.005] * 4
@@ -153,12 +187,39 @@ def test_a_numeric_factor_with_two_values_is_numeric():
     rows = pd.concat([rows, rows.assign(index=rows["index"] + 12)])
     effects = factor_effects(rows)
     amp = [e for e in effects if e["factor"] == "amp"]
-    assert {e["kind"] for e in amp} == {"numeric"}
+    assert {e["kind"] for e in amp} == {"levels"}
+    cs = next(e for e in amp if e["controller"] == "cs")
+    assert list(cs["runs"]) == ["0.005", "0.01"] and cs["runs"] == {
+        "0.005": 4,
+        "0.01": 2,
+    }
     mode = next(e for e in effects if e["factor"] == "mode" and e["controller"] == "cs")
     assert mode["kind"] == "levels" and mode["runs"] == {"hold": 4, "nan": 2}
     assert mode["medians"] == {"hold": 6.8, "nan": 5.8}
     dead = [e for e in effects if e["factor"] == "dead"]
     assert {e["kind"] for e in dead} == {"constant"} and dead[0]["value"] == "true"
+
+
+def test_a_drawn_factor_gets_its_rank_correlation_runs_and_p():
+    """Drawn values (more than three): Spearman's rho with its p and the run
+    count; a zero correlation reads 0, not a 3e-17 residue."""
+    n = 12
+    rows = pd.DataFrame(
+        {
+            "index": range(n),
+            "status": "ok",
+            "factor.controller": "vs-vf",
+            "factor.amp": [0.001 * (i + 1) for i in range(n)],
+            "peak_force_N": [6.0 + 0.1 * i for i in range(n)],
+            "contact_loss_s": 0.0,
+        }
+    )
+    (e,) = factor_effects(rows)
+    assert e["kind"] == "numeric" and e["runs"] == n
+    assert e["spearman"] == 1.0 and e["spearman_p"] < 1e-6
+    rows["peak_force_N"] = [7, 6, 6, 7, 7, 6, 6, 7, 7, 6, 6, 7]  # No trend.
+    (e,) = factor_effects(rows)
+    assert e["spearman"] == 0.0 and e["spearman_p"] == pytest.approx(1.0)
 
 
 def test_runs_that_never_touched_the_patient_are_counted_not_dropped():

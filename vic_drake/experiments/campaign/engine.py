@@ -9,6 +9,7 @@ starts), then submits the runs still to do to a Dask cluster: a
 The output folder::
 
     spec.yaml             the campaign spec (a resume must match it)
+    base_scenario.yaml    its base scenario as loaded (a resume must match it)
     scenarios/RUN.yaml    each finished run's exact scenario (vic-drake scan RUN.yaml)
     rows/RUN.json         each finished run's row, written atomically
     results.parquet       every row (written at the end)
@@ -23,8 +24,9 @@ start leaves nothing behind.
 A worker that dies loses its current run; the scheduler gives that run to
 another worker once (``distributed.scheduler.allowed-failures`` = 1 on a
 local cluster; an external scheduler uses its own setting), then the run is
-recorded as failed. ``resume`` skips every run with a row and never runs
-one twice.
+recorded as failed. ``resume`` skips every run with a row, except those
+that failed with an error (a lost worker, a broken node: they are run
+again), and never runs one twice.
 
 Each row carries the ``code_id`` (:func:`vic_drake.provenance.code_id`) of
 the process that computed it. A resume whose code differs from the stored
@@ -42,6 +44,7 @@ once the cluster is up: the cluster is closed and nothing is written.
 
 from __future__ import annotations
 
+import difflib
 import json
 import os
 import shlex
@@ -53,10 +56,11 @@ import pandas as pd
 
 from vic_drake.errors import VicDrakeError
 from vic_drake.experiments.campaign.plan import RunPlan, plan_campaign
-from vic_drake.experiments.campaign.run import failed_row
+from vic_drake.experiments.campaign.run import METRIC_KEYS, failed_row
 from vic_drake.experiments.campaign.spec import CampaignSpec, load_campaign_spec
 from vic_drake.experiments.campaign.stats import paired_arms, per_controller
 from vic_drake.experiments.dask_cluster import dask_session
+from vic_drake.jsonio import to_json
 from vic_drake.paper import CONTACT_THRESHOLD_N
 from vic_drake.paths import (
     CAMPAIGN_SCENARIOS_DIR,
@@ -65,6 +69,9 @@ from vic_drake.paths import (
 )
 from vic_drake.provenance import code_id
 from vic_drake.scenario import dumps_scenario, load_scenario
+
+#: The campaign's base scenario as it was loaded (a resume must match it).
+CAMPAIGN_BASE_FILE = "base_scenario.yaml"
 
 
 def _atomic_write(path: Path, text: str) -> None:
@@ -86,26 +93,32 @@ def read_rows(out: Path) -> pd.DataFrame:
         json.loads(p.read_text()) for p in sorted((out / "rows").glob("run_*.json"))
     ]
     df = pd.DataFrame(rows)
-    return df.sort_values("index").reset_index(drop=True) if not df.empty else df
+    if df.empty:
+        return df
+    # The rows hold null where a figure is NaN (strict JSON).
+    for key in (*METRIC_KEYS, "sim_s", "wall_s"):
+        if key in df:
+            df[key] = pd.to_numeric(df[key], errors="coerce")
+    return df.sort_values("index").reset_index(drop=True)
 
 
 def _check_out(
     out: Path,
-    spec_text: str,
+    texts: dict,
     plans: list[RunPlan],
     resume: bool,
     emit,
     allow_code_change: bool = False,
 ) -> set[str]:
     """Checks ``out`` before any work, writing nothing; returns the run ids
-    already finished there.
+    finished there (a run whose row says it failed with an error is not:
+    a resume runs it again).
 
     ``out`` may be new, an empty folder, or (with ``resume``) this
-    campaign's folder, whose rows were computed by this code (or
-    ``allow_code_change``); a folder holding anything else is refused, so a
-    campaign never mixes its files into another run's folder.
+    campaign's folder: the same spec and base scenario, rows computed by
+    this code (or ``allow_code_change``). A folder holding anything else is
+    refused, so a campaign never mixes its files into another run's folder.
     """
-    stored = out / CAMPAIGN_SPEC_FILE
     own = check_run_folder(
         out, CAMPAIGN_SPEC_FILE, others="(with --resume) a campaign's own folder"
     )
@@ -115,12 +128,22 @@ def _check_out(
                 f"{str(out)!r} already holds a campaign; pass --resume to finish it "
                 "or choose another --out"
             )
-        if stored.read_text() != spec_text:
-            raise VicDrakeError(
-                f"{str(out)!r} holds another campaign spec; --resume needs the same spec"
+        _check_same(
+            out / CAMPAIGN_SPEC_FILE, texts[CAMPAIGN_SPEC_FILE], "campaign spec"
+        )
+        if (out / CAMPAIGN_BASE_FILE).is_file():  # Folders before it: not kept.
+            _check_same(
+                out / CAMPAIGN_BASE_FILE, texts[CAMPAIGN_BASE_FILE], "base scenario"
             )
         planned = {p.run_id for p in plans}
-        done = {p.stem for p in (out / "rows").glob("run_*.json")} & planned
+        stored = {p.stem for p in (out / "rows").glob("run_*.json")} & planned
+        failed = {r for r in stored if _row(out, r).get("status") == "error"}
+        done = stored - failed
+        if failed:
+            emit(
+                f"{len(failed)} run{'s' if len(failed) > 1 else ''} of {str(out)!r} "
+                "failed with an error before: running them again"
+            )
         if not allow_code_change and len(done) < len(planned):
             # Runs to add: they must be the stored rows' code's. (With none
             # left, a resume only summarises the rows again.)
@@ -134,6 +157,30 @@ def _check_out(
     return set()
 
 
+def _row(out: Path, run_id: str) -> dict:
+    return json.loads((out / "rows" / f"{run_id}.json").read_text())
+
+
+def _check_same(stored: Path, text: str, what: str) -> None:
+    """Refuses a resume whose spec or base scenario is not the stored one,
+    showing the first lines that differ."""
+    before = stored.read_text()
+    if before == text:
+        return
+    diff = [
+        line
+        for line in difflib.unified_diff(
+            before.splitlines(), text.splitlines(), lineterm="", n=0
+        )
+        if line[:1] in "+-" and line[:3] not in ("+++", "---")
+    ]
+    shown = "; ".join(diff[:6]) + ("; ..." if len(diff) > 6 else "")
+    raise VicDrakeError(
+        f"{str(stored.parent)!r} holds another {what} ({stored.name}); --resume "
+        f"needs the same. Stored (-) and now (+): {shown}"
+    )
+
+
 #: What a row written before rows carried their code shows as its code.
 UNKNOWN_CODE = "unknown (a row written before rows recorded their code)"
 
@@ -142,8 +189,7 @@ def _stored_codes(out: Path, run_ids) -> dict[str, int]:
     """{code_id: rows} of the stored rows ``run_ids``."""
     counts: dict[str, int] = {}
     for run_id in sorted(run_ids):
-        row = json.loads((out / "rows" / f"{run_id}.json").read_text())
-        code = row.get("code_id") or UNKNOWN_CODE
+        code = _row(out, run_id).get("code_id") or UNKNOWN_CODE
         counts[code] = counts.get(code, 0) + 1
     return counts
 
@@ -163,11 +209,16 @@ def _check_stored_code(out: Path, run_ids) -> None:
         )
 
 
-def _create(out: Path, spec_text: str) -> None:
-    """Makes the campaign's folder and writes its spec (once the runs can start)."""
+def _create(out: Path, texts: dict) -> None:
+    """Makes the campaign's folder and writes its spec and base scenario
+    (once the runs can start). A folder from before the base scenario was
+    kept does not get one: its rows' base is not known."""
+    new = not (out / CAMPAIGN_SPEC_FILE).is_file()
     (out / CAMPAIGN_SCENARIOS_DIR).mkdir(parents=True, exist_ok=True)
     (out / "rows").mkdir(exist_ok=True)
-    _atomic_write(out / CAMPAIGN_SPEC_FILE, spec_text)
+    for name, text in texts.items():
+        if new or name == CAMPAIGN_SPEC_FILE:
+            _atomic_write(out / name, text)
 
 
 def _record(out: Path, plan: RunPlan, row: dict) -> None:
@@ -176,7 +227,7 @@ def _record(out: Path, plan: RunPlan, row: dict) -> None:
     if text is None:  # The worker never got to build it (e.g. it died).
         text = dumps_scenario(plan.scenario())
     _atomic_write(out / CAMPAIGN_SCENARIOS_DIR / f"{plan.run_id}.yaml", text)
-    _atomic_write(out / "rows" / f"{plan.run_id}.json", json.dumps(row))
+    _atomic_write(out / "rows" / f"{plan.run_id}.json", to_json(row, indent=None))
 
 
 class _Progress:
@@ -247,11 +298,15 @@ def run_campaign(
     if workers is not None and (isinstance(workers, bool) or workers < 1):
         raise VicDrakeError(f"--workers must be >= 1; got {workers!r}")
     spec, base_path = load_campaign_spec(spec_path)
-    plans = plan_campaign(spec, load_scenario(base_path))
+    base = load_scenario(base_path)
+    plans = plan_campaign(spec, base)
     out = Path(out)
     emit = progress or (lambda _line: None)
-    spec_text = _spec_text(spec, base_path)
-    done = _check_out(out, spec_text, plans, resume, emit, allow_code_change)
+    texts = {
+        CAMPAIGN_SPEC_FILE: _spec_text(spec, base_path),
+        CAMPAIGN_BASE_FILE: dumps_scenario(base),
+    }
+    done = _check_out(out, texts, plans, resume, emit, allow_code_change)
     todo = [p for p in plans if p.run_id not in done]
     if max_runs is not None:
         todo = todo[:max_runs]
@@ -262,9 +317,9 @@ def run_campaign(
         # The folder is made once the cluster is reached (_submit): a
         # campaign that cannot start leaves nothing behind.
         hint = _resume_command(spec_path, out, workers, scheduler)
-        n_workers = _submit(todo, out, spec_text, workers, scheduler, bar, emit, hint)
+        n_workers = _submit(todo, out, texts, workers, scheduler, bar, emit, hint)
     else:
-        _create(out, spec_text)
+        _create(out, texts)
     wall = time.perf_counter() - t0
     rows = read_rows(out)
     summary = summary_dict(spec, rows)
@@ -282,7 +337,7 @@ def run_campaign(
 
 
 def _submit(
-    todo, out: Path, spec_text: str, workers, scheduler, bar: _Progress, emit, hint
+    todo, out: Path, texts: dict, workers, scheduler, bar: _Progress, emit, hint
 ) -> int:
     from distributed import as_completed
 
@@ -292,7 +347,7 @@ def _submit(
     try:
         with dask_session(workers, scheduler) as (client, futures):
             started = True
-            _create(out, spec_text)
+            _create(out, texts)
             n_workers = len(client.scheduler_info()["workers"])
             emit(
                 f"[{bar.name}] {len(todo)} runs on {n_workers} Dask workers "

@@ -8,6 +8,7 @@ with the same calls, so both see the same coercions and the same errors.
 from __future__ import annotations
 
 import copy
+import difflib
 import re
 from dataclasses import fields, is_dataclass
 
@@ -22,32 +23,57 @@ _INDEXED = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)\[(\d+)\]$")
 BOOL_LABELS = {"true": True, "false": False}
 
 
+def _slot(scenario: Scenario, path: str) -> tuple[object, str, int | None]:
+    """Where a dotted field path (``a.b[2].c``) ends: (the object holding
+    it, the field's name, the item's index or None).
+
+    Raises:
+        VicDrakeError: an unknown field (with the fields there and the close
+            names) or item.
+    """
+    obj = scenario
+    parts = path.split(".")
+    for k, part in enumerate(parts):
+        m = _INDEXED.match(part)
+        name, index = (m.group(1), int(m.group(2))) if m else (part, None)
+        names = [f.name for f in fields(obj)] if is_dataclass(obj) else []
+        if name not in names:
+            near = difflib.get_close_matches(name, names, n=3, cutoff=0.5)
+            where = ".".join(parts[:k]) or "the scenario"
+            raise VicDrakeError(
+                f"factor {path!r}: {where} has no field {name!r}"
+                + (f"; did you mean {', '.join(near)}?" if near else "")
+                + (f" Its fields: {', '.join(names)}" if names else "")
+            )
+        if index is not None:
+            seq = getattr(obj, name)
+            if not isinstance(seq, list) or index >= len(seq):
+                raise VicDrakeError(f"factor {path!r}: {name} has no item {index}")
+        if k == len(parts) - 1:
+            return obj, name, index
+        obj = getattr(obj, name) if index is None else getattr(obj, name)[index]
+    raise VicDrakeError(f"factor {path!r}: an empty field path")
+
+
+def field_value(scenario: Scenario, path: str):
+    """The value a dotted field path holds (VicDrakeError: unknown field)."""
+    obj, name, index = _slot(scenario, path)
+    value = getattr(obj, name)
+    return value if index is None else value[index]
+
+
 def set_field(scenario: Scenario, path: str, value) -> None:
     """Sets a dotted field path (``a.b[2].c``) of a scenario, type-checked.
 
     Raises:
         VicDrakeError: an unknown field, or a value of the wrong kind.
     """
-    obj = scenario
-    parts = path.split(".")
-    for k, part in enumerate(parts):
-        last = k == len(parts) - 1
-        m = _INDEXED.match(part)
-        name, index = (m.group(1), int(m.group(2))) if m else (part, None)
-        if not (is_dataclass(obj) and name in {f.name for f in fields(obj)}):
-            raise VicDrakeError(f"factor {path!r}: the scenario has no field {part!r}")
-        if index is not None:
-            seq = getattr(obj, name)
-            if not isinstance(seq, list) or index >= len(seq):
-                raise VicDrakeError(f"factor {path!r}: {name} has no item {index}")
-            if last:
-                seq[index] = _coerce(path, seq[index], value)
-                return
-            obj = seq[index]
-        elif last:
-            setattr(obj, name, _coerce(path, getattr(obj, name), value))
-        else:
-            obj = getattr(obj, name)
+    obj, name, index = _slot(scenario, path)
+    if index is None:
+        setattr(obj, name, _coerce(path, getattr(obj, name), value))
+    else:
+        seq = getattr(obj, name)
+        seq[index] = _coerce(path, seq[index], value)
 
 
 def _coerce(path: str, current, value):

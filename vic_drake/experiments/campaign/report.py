@@ -16,6 +16,7 @@ import io
 import json
 import math
 import os
+import shlex
 from pathlib import Path
 
 import numpy as np
@@ -33,6 +34,7 @@ from vic_drake.experiments.campaign.stats import (
     touched,
     worst_runs,
 )
+from vic_drake.jsonio import to_json
 from vic_drake.paper import CONTACT_THRESHOLD_N
 
 
@@ -189,6 +191,7 @@ def _header(spec: CampaignSpec, summary: dict) -> list[str]:
         parts.append(
             f"<p>The spec's description: <q>{html.escape(spec.description)}</q></p>"
         )
+    parts.append(_factors_html(spec))
     parts.append(
         f"<p>{summary['finished']} of {summary['runs']} runs finished, "
         f"{summary['failed']} failed ({summary['nan_runs']} NaN).</p>"
@@ -203,6 +206,28 @@ def _header(spec: CampaignSpec, summary: dict) -> list[str]:
             f"--allow-code-change): {mixed}.</p>"
         )
     return parts
+
+
+def _factors_html(spec: CampaignSpec) -> str:
+    """What the campaign varies: each factor's field and distribution."""
+
+    def drawn(f) -> str:
+        if f.dist == "uniform":
+            return f"uniform from {f.low:g} to {f.high:g}"
+        if f.dist == "normal":
+            clip = f", clipped to [{f.low:g}, {f.high:g}]" if f.low < f.high else ""
+            return f"normal, mean {f.mean:g}, std {f.std:g}{clip}"
+        levels = ", ".join(str(v) if isinstance(v, str) else f"{v:g}" for v in f.levels)
+        if f.dist == "grid":
+            return f"grid: {levels} (each round of runs has every one)"
+        return f"choice of {levels} (one drawn per run)"
+
+    rows = [[html.escape(f.field), html.escape(drawn(f))] for f in spec.factors]
+    if spec.population:
+        rows.append(["patient", "a synthetic patient drawn per round"])
+    return "<h2>What varies</h2>" + _table(
+        ["factor (scenario field)", "drawn"], rows, empty="Nothing varies."
+    )
 
 
 def _legend(items: list[tuple[str, str]]) -> str:
@@ -293,7 +318,9 @@ def _effects_html(touched: pd.DataFrame, untouched: int) -> tuple[str, list[str]
                 [
                     "factor",
                     "controller",
+                    "runs",
                     "Spearman rho",
+                    "p (two-sided)",
                     "median, lowest third (N)",
                     "median, highest third (N)",
                 ],
@@ -301,7 +328,11 @@ def _effects_html(touched: pd.DataFrame, untouched: int) -> tuple[str, list[str]
                     [
                         html.escape(e["factor"]),
                         html.escape(e["controller"]),
-                        _fmt(e["spearman"]),
+                        str(e["runs"]),
+                        f"{e['spearman']:.2f}"
+                        if e["spearman"] == e["spearman"]
+                        else "—",
+                        _fmt(e["spearman_p"]),
                         _fmt(e["low_third_median"]),
                         _fmt(e["high_third_median"]),
                     ]
@@ -419,8 +450,10 @@ def summary_html(
 
 
 def replay_command(out: Path, run_id: str) -> str:
-    """The command that replays one run."""
-    return f"vic-drake scan {out / 'scenarios' / f'{run_id}.yaml'}"
+    """The command that replays one run, from any folder (the path made
+    absolute, quoted for a shell where it needs it)."""
+    path = Path(out).resolve() / "scenarios" / f"{run_id}.yaml"
+    return f"vic-drake scan {shlex.quote(str(path))}"
 
 
 def write_outputs(
@@ -438,17 +471,8 @@ def write_outputs(
         buf = io.BytesIO()
         table.to_parquet(buf, index=False)
         _atomic(out / "results.parquet", buf.getvalue())
-    _atomic(
-        out / "summary.json",
-        json.dumps(summary, indent=2, default=_json_default).encode(),
-    )
+    _atomic(out / "summary.json", to_json(summary).encode())
     _atomic(out / "summary.html", summary_html(out, spec, rows, summary).encode())
-
-
-def _json_default(v):
-    if isinstance(v, np.generic):
-        return v.item()
-    raise TypeError(type(v).__name__)
 
 
 __all__ = ["replay_command", "summary_html", "write_outputs"]

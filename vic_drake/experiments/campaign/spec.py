@@ -39,11 +39,16 @@ from operator import attrgetter
 from pathlib import Path
 
 from vic_drake.errors import VicDrakeError
-from vic_drake.experiments.campaign.fields import apply_controller, set_field
+from vic_drake.experiments.campaign.fields import (
+    apply_controller,
+    field_value,
+    set_field,
+)
 from vic_drake.experiments.scan_diagram import (
     initial_joint_positions,
     load_scenario_phantom,
 )
+from vic_drake.run_limits import MAX_EXTRA_DURATION_S
 from vic_drake.scenario import Scenario, as_plain, load_scenario
 from vic_drake.scenario.io import load_typed
 
@@ -101,6 +106,14 @@ class Factor:
                 raise VicDrakeError(
                     f"{where} ({self.field}): {self.dist} needs either values "
                     "(numbers) or labels (strings), not both"
+                )
+            levels = self.levels
+            twice = [v for i, v in enumerate(levels) if v in levels[:i]]
+            if self.dist == "grid" and twice:  # A choice may weight by repeating.
+                raise VicDrakeError(
+                    f"{where} ({self.field}): the grid lists {twice[0]!r} more than "
+                    "once; give each level once (a repeated cell runs the same "
+                    "scans twice as if they were two arms)"
                 )
         elif self.values or self.labels:
             raise VicDrakeError(
@@ -286,6 +299,14 @@ def check_factor_ranges(spec: CampaignSpec, base: Scenario, where: str) -> None:
             value (low, high or label) and the scenario's own message.
     """
     seen: set = set()
+    end = float(base.trajectory.end_time_s)
+    limit = max(float(base.total_duration_s), end + 1.0) + MAX_EXTRA_DURATION_S
+    if spec.duration_s > limit:  # The probe only holds still after its end.
+        raise VicDrakeError(
+            f"{where}: duration_s {spec.duration_s:g} s is far beyond the base "
+            f"scenario: its trajectory ends at {end:.1f} s; give at most "
+            f"{limit:.1f} s (each of the {spec.runs} runs is simulated that long)"
+        )
     start = copy.deepcopy(base)
     start.duration_s = float(spec.duration_s)  # As run_scenario does.
     if spec.population:
@@ -297,6 +318,9 @@ def check_factor_ranges(spec: CampaignSpec, base: Scenario, where: str) -> None:
             f"{where}: the base scenario {spec.base_scenario!r}, with the "
             f"campaign's duration_s and population, fails: {exc}"
         ) from None
+    for i, f in enumerate(spec.factors):
+        if f.field != CONTROLLER_FACTOR:
+            _check_field_kind(where, i, f, start)
     arms = {"": start}
     for i, f in enumerate(spec.factors):
         if f.field == CONTROLLER_FACTOR:
@@ -320,6 +344,23 @@ def check_factor_ranges(spec: CampaignSpec, base: Scenario, where: str) -> None:
                 raise _range_error(
                     where, i, f, which, value, next(iter(errors.values())), only
                 )
+
+
+def _check_field_kind(where: str, i: int, f: Factor, base: Scenario) -> None:
+    """The factor's field exists, and an integer field is drawn from levels:
+    a uniform or normal draw would be rounded in the scenario while the row
+    records the unrounded number, and its levels drawn unevenly."""
+    try:
+        current = field_value(base, f.field)
+    except VicDrakeError as exc:
+        raise VicDrakeError(f"{where}: factors[{i}]: {exc}") from None
+    integer = isinstance(current, int) and not isinstance(current, bool)
+    if integer and f.dist in ("uniform", "normal"):
+        raise VicDrakeError(
+            f"{where}: factors[{i}] ({f.field}) is an integer field: draw it with "
+            f"dist grid or choice and its values (e.g. values: [{current}, ...]), "
+            f"not {f.dist}"
+        )
 
 
 def _arm(where, i, f, which, label, start, seen) -> Scenario:

@@ -105,6 +105,10 @@ def _is_numeric(column: pd.Series) -> bool:
     )
 
 
+#: A numeric factor with at most this many values is summarised per value.
+MAX_LEVELS = 3
+
+
 def factor_effects(rows: pd.DataFrame, metric: str = "peak_force_N") -> list[dict]:
     """Each factor's effect on a metric, per controller.
 
@@ -113,10 +117,13 @@ def factor_effects(rows: pd.DataFrame, metric: str = "peak_force_N") -> list[dic
     - ``too_few``: the controller has fewer than :data:`MIN_EFFECT_RUNS`
       scored runs with the metric (``runs``): no effect is computed;
     - ``constant``: the factor took one ``value`` in its runs;
-    - ``numeric`` (a numeric factor, whatever its number of values):
-      Spearman's rank correlation and the metric's median in the factor's
+    - ``numeric`` (a numeric factor with more than
+      :data:`MAX_LEVELS` values): Spearman's rank correlation with its
+      two-sided p and the runs, and the metric's median in the factor's
       lowest and highest third;
-    - ``levels`` (a label factor): the metric's median and the runs per label.
+    - ``levels`` (a label factor, or a numeric one with at most
+      :data:`MAX_LEVELS` values, e.g. a choice of two): the metric's median
+      and the runs per value.
     """
     effects = []
     ok = rows[(rows["status"] != "error") & np.isfinite(rows[metric].astype(float))]
@@ -139,18 +146,26 @@ def factor_effects(rows: pd.DataFrame, metric: str = "peak_force_N") -> list[dic
                 if isinstance(value, np.generic):
                     value = value.item()
                 entry.update(kind="constant", value=value)
-            elif numeric:
+            elif numeric and x.nunique() > MAX_LEVELS:
                 xv = x.to_numpy(float)
-                rho = pd.Series(xv).rank().corr(pd.Series(y).rank())
+                rho, p = _spearman(xv, y)
                 lo, hi = np.quantile(xv, [1 / 3, 2 / 3])
                 entry.update(
                     kind="numeric",
-                    spearman=float(rho) if np.isfinite(rho) else math.nan,
+                    spearman=rho,
+                    spearman_p=p,
+                    runs=int(len(group)),
                     low_third_median=_stat(y[xv <= lo], np.median),
                     high_third_median=_stat(y[xv >= hi], np.median),
                 )
             else:
-                levels = group.groupby(x.astype(str), sort=True)
+                if numeric:  # A few numbers: by value, in order, as text.
+                    x = x.astype(float).map(lambda v: f"{v:g}")
+                    order = sorted(x.unique(), key=float)
+                else:
+                    order = sorted(x.astype(str).unique())
+                levels = dict(list(group.groupby(x.astype(str), sort=False)))
+                levels = [(k, levels[k]) for k in order]
                 entry.update(
                     kind="levels",
                     medians={k: _stat(g[metric], np.median) for k, g in levels},
@@ -158,6 +173,17 @@ def factor_effects(rows: pd.DataFrame, metric: str = "peak_force_N") -> list[dic
                 )
             effects.append(entry)
     return effects
+
+
+def _spearman(x: np.ndarray, y: np.ndarray) -> tuple[float, float]:
+    """Spearman's rho (rounded to 12 digits: a zero reads 0, not 3e-17) and
+    its two-sided p; NaN where either side is constant."""
+    from scipy.stats import spearmanr
+
+    if np.ptp(x) == 0 or np.ptp(y) == 0:
+        return math.nan, math.nan
+    result = spearmanr(x, y)
+    return round(float(result.statistic), 12), float(result.pvalue)
 
 
 def _discordant(a: np.ndarray, b: np.ndarray) -> dict:
@@ -175,24 +201,52 @@ def _discordant(a: np.ndarray, b: np.ndarray) -> dict:
     }
 
 
+#: The factors that make a run's arm (its controller label:
+#: :func:`~vic_drake.experiments.campaign.plan.controller_arm`).
+ARM_FACTORS = ("controller", "stiffness_source", "watchdog.enabled")
+
+
+def _pair_keys(ok: pd.DataFrame, grid_size: int) -> pd.Series:
+    """A run's pair: its grid round and its values of every factor that is
+    not an arm's (in a paired round the drawn ones are shared, the other
+    grid factors' pick the cell)."""
+    key = (ok["index"] // grid_size).astype(str)
+    arm_columns = {f"factor.{name}" for name in ARM_FACTORS}
+    for column in sorted(ok.columns):
+        if column.startswith("factor.") and column not in arm_columns:
+            key = key + "|" + ok[column].astype(str)
+    return key
+
+
+def _one_run_per_key(arm: pd.DataFrame) -> pd.DataFrame:
+    """An arm's runs by pair key; a key held twice (one arm twice in a
+    cell) pairs with nothing."""
+    arm = arm.set_index("_pair")
+    return arm[~arm.index.duplicated(keep=False)]
+
+
 def paired_arms(rows: pd.DataFrame, grid_size: int, force_limit_N: float) -> list[dict]:
     """The arms compared run for run in a paired campaign (the runs of one grid
     round share every draw: ``paired: true``), for each two arms in name order.
 
-    Pairs where either run failed are left out. For each: the pairs, the
-    peak force difference (second minus first: median, 10 and 90 %), and
-    the pairs where one arm, the other or both lost contact or exceeded the
-    force limit, with the exact McNemar p of the discordant pairs.
+    A pair is two runs of one round that differ only in their arm: with
+    other grid factors (e.g. a breathing amplitude), each of their cells
+    pairs apart. Pairs where either run failed are left out. For each: the
+    pairs, the peak force difference (second minus first: median, 10 and 90
+    %), and the pairs where one arm, the other or both lost contact or
+    exceeded the force limit, with the exact McNemar p of the discordant
+    pairs.
     """
     if rows.empty or grid_size < 2:
         return []
-    ok = rows[rows["status"] == "ok"].assign(_pair=rows["index"] // grid_size)
+    ok = rows[rows["status"] == "ok"]
+    ok = ok.assign(_pair=_pair_keys(ok, grid_size))
     arms = sorted(str(a) for a in ok["factor.controller"].unique())
     out = []
     for i, first in enumerate(arms):
         for second in arms[i + 1 :]:
-            a = ok[ok["factor.controller"] == first].set_index("_pair")
-            b = ok[ok["factor.controller"] == second].set_index("_pair")
+            a = _one_run_per_key(ok[ok["factor.controller"] == first])
+            b = _one_run_per_key(ok[ok["factor.controller"] == second])
             common = a.index.intersection(b.index)
             if not common.size:
                 continue
