@@ -188,9 +188,9 @@ def test_a_path_past_the_phantom_is_warned():
     phantom = SyntheticChestPhantom()
     assert path_outside_phantom(synthetic_scenario("cf"), phantom) is None
     scenario = synthetic_scenario("cf")
-    scenario.trajectory.end_x_m = scenario.trajectory.end_x_m - 0.3
+    scenario.trajectory.end_x_m = scenario.trajectory.end_x_m - 0.08
     message = path_outside_phantom(scenario, phantom)
-    assert "passes the phantom's footprint by" in message and "mm in x" in message
+    assert "passes the phantom's footprint by 19 mm in x" in message
     with pytest.warns(VicDrakeWarning, match="passes the phantom's footprint"):
         run_scan(scenario, phantom=phantom, duration_s=0.02)
     # The phantom moved by the station's offset moves its footprint: the
@@ -203,3 +203,30 @@ def test_a_path_past_the_phantom_is_warned():
     out = io.StringIO()
     _show_warning(message, VicDrakeWarning, "x.py", 1, file=out)
     assert out.getvalue() == f"vic-drake: warning: {message}\n"
+
+
+def test_a_path_past_the_arms_reach_is_warned():
+    """The start's IK is checked when the run is built; a scan end the arm
+    cannot reach (a 72 s run stuck at x = -0.47 m in the review) is warned."""
+    from vic_drake.errors import VicDrakeWarning
+    from vic_drake.experiments.scan_run import path_out_of_reach
+
+    assert path_out_of_reach(synthetic_scenario("cf")) is None
+    scenario = synthetic_scenario("cf")
+    scenario.trajectory.end_x_m = -0.64
+    message = path_out_of_reach(scenario)
+    assert "leaves the arm's reach at (-0.640, -0.360, 0.085) m" in message
+    with pytest.warns(VicDrakeWarning) as record:
+        run_scan(scenario, duration_s=0.02)
+    said = [str(w.message) for w in record]
+    # So far out, it is also past the chest: both are said.
+    assert any("leaves the arm's reach" in m for m in said)
+    assert any("passes the phantom's footprint by 415 mm" in m for m in said)
+    # A waypoint path is checked along its rows.
+    scenario = synthetic_scenario("cf")
+    scenario.trajectory.waypoints = [
+        [0.0, 0.036, -0.36, 0.12],
+        [5.0, -0.2, -0.36, 0.09],
+        [10.0, -0.7, -0.36, 0.09],
+    ]
+    assert "(-0.700, -0.360, 0.090)" in path_out_of_reach(scenario)

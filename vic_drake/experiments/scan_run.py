@@ -31,6 +31,7 @@ from vic_drake.experiments.scan_diagram import (
 )
 from vic_drake.experiments.scan_logs import logs_to_frame
 from vic_drake.scenario import Scenario
+from vic_drake.station.ik import solve_tip_ik
 
 #: How far the target's path may pass the phantom's footprint before
 #: :func:`run_scan` warns, m (the shipped scans end 5 mm past the measured
@@ -68,6 +69,41 @@ def path_outside_phantom(scenario: Scenario, phantom) -> str | None:
         f"{parts} (x {x0:.4f} to {x1:.4f} m, y {y0:.4f} to {y1:.4f} m); past it "
         "the phantom holds its edge's surface, kappa and lambda"
     )
+
+
+def path_out_of_reach(scenario: Scenario) -> str | None:
+    """Where the target's path leaves the arm's reach (probe down), or None.
+
+    The start is checked when the run is built (its IK); this checks the
+    rest of the path at a few points: the scan's ends and its lift (or,
+    for a waypoint path, five rows spread over it), about 4 ms each. Past
+    its reach the arm stops short, and the run scores a scan it did not do.
+    """
+    traj = scenario.trajectory
+    if traj.waypoints:
+        rows = list(traj.waypoints)
+        picks = sorted({round(i * (len(rows) - 1) / 4) for i in range(5)})
+        points = [tuple(float(v) for v in rows[i][1:4]) for i in picks]
+    else:
+        z = float(traj.target_z_m)
+        points = [
+            (float(traj.start_x_m), float(traj.y_m), z),
+            (float(traj.end_x_m), float(traj.y_m), z),
+        ]
+        if traj.liftoff_height_m > 0:
+            points.append((points[1][0], points[1][1], z + traj.liftoff_height_m))
+    for point in points:
+        try:
+            solve_tip_ik(point, params=scenario.station)
+        except VicDrakeError:
+            shown = ", ".join(f"{v:.3f}" for v in point)
+            return (
+                f"{scenario.name}: the target's path leaves the arm's reach at "
+                f"({shown}) m (no joint configuration puts the probe there "
+                "pointing down): the arm stops short, and the run's figures are "
+                "not those of the scan asked for"
+            )
+    return None
 
 
 @dataclass
@@ -156,9 +192,12 @@ def run_scan(
     t_build = time.perf_counter()
     if phantom is None:
         phantom = load_scenario_phantom(scenario, data_dir=data_dir)
-    outside = path_outside_phantom(scenario, phantom)
-    if outside:
-        warnings.warn(outside, VicDrakeWarning, stacklevel=2)
+    for problem in (
+        path_outside_phantom(scenario, phantom),
+        path_out_of_reach(scenario),
+    ):
+        if problem:
+            warnings.warn(problem, VicDrakeWarning, stacklevel=2)
     diagram, logs = MakeScanDiagram(
         scenario,
         phantom=phantom,
@@ -219,6 +258,7 @@ def run_scan(
 __all__ = [
     "PATH_OUTSIDE_TOLERANCE_M",
     "ScanResult",
+    "path_out_of_reach",
     "path_outside_phantom",
     "run_scan",
 ]
