@@ -96,8 +96,9 @@ def _human(result: dict) -> str:
     width = max([10, *(len(name) for name in result["per_controller"])])
     limit = result["force_limit_N"]
     lines = [
-        f"{result['finished']}/{result['runs']} runs finished, {result['failed']} failed "
-        f"({result['nan_runs']} NaN); {session}",
+        f"{result['finished']}/{result['runs']} runs done: "
+        f"{result['finished'] - result['failed']} ok, {result['failed']} failed "
+        f"({result['nan_runs']} of them NaN); {session}",
         f"{'controller':<{width}} {'runs':>5} {'no contact':>10} {'peakF p50':>10} "
         f"{'peakF max':>10} {f'P(>{limit:g} N)':>10} {'95% CI':>16} "
         f"{'loss p50 s':>10} {'tank min J':>10} {'wd stops':>8}",

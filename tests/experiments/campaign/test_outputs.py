@@ -400,7 +400,8 @@ def test_after_a_resume_the_rate_is_this_sessions_and_says_so():
     # that these are 8 runs, not the 16 finished.
     line = _human(_result(8)).splitlines()[0]
     assert line == (
-        "16/16 runs finished, 0 failed (0 NaN); this session 8 runs in 15 s on "
+        "16/16 runs done: 16 ok, 0 failed (0 of them NaN); this session 8 runs in "
+        "15 s on "
         "2 workers, 1920 runs/h (8 finished before)"
     )
     assert (

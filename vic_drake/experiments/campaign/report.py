@@ -193,8 +193,9 @@ def _header(spec: CampaignSpec, summary: dict) -> list[str]:
         )
     parts.append(_factors_html(spec))
     parts.append(
-        f"<p>{summary['finished']} of {summary['runs']} runs finished, "
-        f"{summary['failed']} failed ({summary['nan_runs']} NaN).</p>"
+        f"<p>{summary['finished']} of {summary['runs']} runs done: "
+        f"{summary['finished'] - summary['failed']} ok, {summary['failed']} failed "
+        f"({summary['nan_runs']} of them NaN).</p>"
     )
     codes = summary.get("code_ids", {})
     if len(codes) == 1:
