@@ -40,12 +40,21 @@ def test_the_code_id_names_the_source_drake_and_python():
 
 
 class _Client:
+    """A cluster's client as check_workers sees it: ``ids`` by worker
+    address; ``None`` for a worker whose vic_drake has no worker_status."""
+
     def __init__(self, ids: dict, problems: dict | None = None):
         self.status = {a: (c, (problems or {}).get(a, "")) for a, c in ids.items()}
 
-    def run(self, function):
+    def scheduler_info(self):
+        return {"workers": {a: {} for a in self.status}}
+
+    def run(self, function, workers):
         assert function is worker_status  # Each worker reports its own.
-        return self.status
+        (addr,) = workers
+        if self.status[addr][0] is None:
+            raise AttributeError("Can't get attribute 'worker_status'")
+        return {addr: self.status[addr]}
 
 
 def test_workers_with_other_code_are_refused_by_name():
@@ -77,3 +86,16 @@ def test_a_worker_that_would_fail_every_run_is_refused(monkeypatch):
         check_workers(client)
     assert str(err.value).startswith("1 Dask worker(s) cannot run scans: tcp://b:2: ")
     assert "mend their environment" in str(err.value)
+
+
+def test_a_worker_on_an_older_vic_drake_is_refused_not_a_traceback():
+    """Dask sends worker_status by name: a worker whose vic_drake predates it
+    fails the call. It runs other code, and is refused as such."""
+    here = code_id()
+    with pytest.raises(VicDrakeError) as err:
+        check_workers(_Client({"tcp://a:1": here, "tcp://old:2": None}))
+    text = str(err.value)
+    assert text.startswith("1 Dask worker(s) run other code than this process")
+    assert (
+        "tcp://old:2: not this vic_drake (worker_status failed: AttributeError)" in text
+    )

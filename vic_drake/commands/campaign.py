@@ -163,6 +163,7 @@ def run_campaign_command(args: argparse.Namespace) -> int:
         "force_limit_N": result["force_limit_N"],
         "per_controller": result["per_controller"],
         "paired": result.get("paired", []),
+        "code_ids": result.get("code_ids", {}),
     }
     emit(out, args.json, _human(human))
     return 0 if out["failed"] == 0 else 1

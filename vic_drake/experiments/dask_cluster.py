@@ -166,7 +166,13 @@ def check_workers(client) -> None:
     that fails every run at once (a bad ``VIC_DRAKE_ALLOCATOR``), which
     would drain the queue into error rows."""
     here = code_id()
-    status = client.run(worker_status)
+    status = {}
+    for addr in sorted(client.scheduler_info()["workers"]):
+        try:  # A worker on an older vic_drake has no worker_status.
+            status[addr] = tuple(client.run(worker_status, workers=[addr])[addr])
+        except Exception as exc:  # Whatever it raised, it is not this code.
+            name = type(exc).__name__
+            status[addr] = (f"not this vic_drake (worker_status failed: {name})", "")
     broken = {a: p for a, (_, p) in status.items() if p}
     other = {a: c for a, (c, p) in status.items() if c != here and not p}
     if broken:

@@ -92,12 +92,11 @@ def _texts() -> dict:
     """SMOKE's spec and base scenario as a campaign folder stores them."""
     from vic_drake.experiments.campaign.spec import load_campaign_spec
     from vic_drake.paths import CAMPAIGN_SPEC_FILE
-    from vic_drake.scenario import dumps_scenario, load_scenario
 
     spec, base = load_campaign_spec(SMOKE)
     return {
         CAMPAIGN_SPEC_FILE: engine._spec_text(spec, base),
-        engine.CAMPAIGN_BASE_FILE: dumps_scenario(load_scenario(base)),
+        engine.CAMPAIGN_BASE_FILE: Path(base).read_text(),
     }
 
 
@@ -166,12 +165,16 @@ def test_a_resume_with_another_base_scenario_or_spec_shows_what_differs(
     out = tmp_path / "c"
     before = _stored_campaign(out, [code_id()] * 2)
     base = out / engine.CAMPAIGN_BASE_FILE
-    base.write_text(base.read_text().replace("seed: 0", "seed: 5", 1))
+    base.write_text(
+        base.read_text().replace("approach_z_m: 0.11", "approach_z_m: 0.12")
+    )
     with pytest.raises(VicDrakeError) as err:
         run_campaign(SMOKE, out, workers=1, resume=True)
     text = str(err.value)
     assert "holds another base scenario (base_scenario.yaml); --resume" in text
-    assert "Stored (-) and now (+): -" in text and "seed: 5" in text
+    # The lines that differ, with their line number.
+    assert "Stored (-) and now (+): -8 +8:; -  approach_z_m: 0.12; " in text
+    assert "+  approach_z_m: 0.11" in text
     assert _listing(out) == before
     spec = out / "spec.yaml"
     base.unlink()  # A folder from before bases were kept: not checked.
@@ -202,6 +205,14 @@ def test_a_resume_runs_the_failed_runs_again(tmp_path, no_cluster):
     assert engine._check_out(out, _texts(), _plans(), True, lambda _: None) == {
         "run_00000"
     }
+    # A resume refused (the kept row is another code's) promises no rerun.
+    row = json.loads((out / "rows" / "run_00000.json").read_text())
+    row["code_id"] = "vic_drake 0.0.9 source 000000000000, drake 1.40.0, python 3.10.0"
+    (out / "rows" / "run_00000.json").write_text(json.dumps(row))
+    lines.clear()
+    with pytest.raises(VicDrakeError, match="holds rows computed by other code"):
+        run_campaign(SMOKE, out, workers=1, resume=True, progress=lines.append)
+    assert lines == []
 
 
 def _plans():
@@ -380,6 +391,24 @@ def test_the_summary_page_shows_a_dash_for_no_tank(tmp_path):
     page = summary_html(tmp_path, CampaignSpec(runs=3), rows, summary)
     assert "<td>—</td>" in page and "<td>0.444</td>" in page
     assert "<td>NaN</td>" not in page and "nan</td>" not in page
+
+
+def test_the_campaign_command_says_when_rows_come_from_two_codes(monkeypatch, capsys):
+    """After a resume with --allow-code-change the console says so, as the
+    summary's files do (the command passes the counts on to its words)."""
+    from vic_drake.cli import main
+    from vic_drake.experiments import campaign
+
+    codes = {"code a": 10, "code b": 6}
+    monkeypatch.setattr(
+        campaign, "run_campaign", lambda *a, **k: {**_result(16), "code_ids": codes}
+    )
+    assert main(["campaign", str(SMOKE), "--out", "unused"]) == 0
+    out = capsys.readouterr().out
+    assert (
+        "rows from more than one code (--allow-code-change): 10 by code a; 6 by code b"
+        in out
+    )
 
 
 def test_the_campaign_command_prints_the_watchdogs_stops(monkeypatch, capsys):

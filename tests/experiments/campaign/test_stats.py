@@ -139,6 +139,25 @@ def test_paired_arms_pair_within_the_other_grid_factors_cells():
     assert c["contact_loss"]["both"] == 0
 
 
+def test_paired_arms_pair_an_arm_made_by_a_field_path():
+    """A grid on controller.reference.controller makes the arms as the
+    controller factor does: its column holds one value per arm and is not
+    part of the pair."""
+    rows = pd.DataFrame(
+        {
+            "index": range(8),
+            "status": "ok",
+            "factor.controller": ["vs-cf", "vs-vf"] * 4,
+            "factor.controller.reference.controller": ["vs-cf", "vs-vf"] * 4,
+            "factor.variations.sensor_faults.noise_std_N": [0.1, 0.1, 0.3, 0.3] * 2,
+            "peak_force_N": [7.0, 8.0] * 4,
+            "contact_loss_s": 0.0,
+        }
+    )
+    (c,) = paired_arms(rows, 2, 15.0)
+    assert c["pairs"] == 4 and c["peak_force_diff_N_p50"] == pytest.approx(1.0)
+
+
 def test_paired_arms_need_a_grid_of_two_or_more():
     assert paired_arms(_paired_rows(), 0, 15.0) == []
     assert paired_arms(_paired_rows().iloc[:0], 2, 15.0) == []

@@ -9,7 +9,7 @@ starts), then submits the runs still to do to a Dask cluster: a
 The output folder::
 
     spec.yaml             the campaign spec (a resume must match it)
-    base_scenario.yaml    its base scenario as loaded (a resume must match it)
+    base_scenario.yaml    its base scenario file (a resume must match it)
     scenarios/RUN.yaml    each finished run's exact scenario (vic-drake scan RUN.yaml)
     rows/RUN.json         each finished run's row, written atomically
     results.parquet       every row (written at the end)
@@ -70,7 +70,7 @@ from vic_drake.paths import (
 from vic_drake.provenance import code_id
 from vic_drake.scenario import dumps_scenario, load_scenario
 
-#: The campaign's base scenario as it was loaded (a resume must match it).
+#: The campaign's base scenario file as it was (a resume must match it).
 CAMPAIGN_BASE_FILE = "base_scenario.yaml"
 
 
@@ -139,15 +139,15 @@ def _check_out(
         stored = {p.stem for p in (out / "rows").glob("run_*.json")} & planned
         failed = {r for r in stored if _row(out, r).get("status") == "error"}
         done = stored - failed
+        if not allow_code_change and len(done) < len(planned):
+            # Runs to add: they must be the stored rows' code's. (With none
+            # left, a resume only summarises the rows again.)
+            _check_stored_code(out, done)
         if failed:
             emit(
                 f"{len(failed)} run{'s' if len(failed) > 1 else ''} of {str(out)!r} "
                 "failed with an error before: running them again"
             )
-        if not allow_code_change and len(done) < len(planned):
-            # Runs to add: they must be the stored rows' code's. (With none
-            # left, a resume only summarises the rows again.)
-            _check_stored_code(out, done)
         return done
     if resume:
         # Starting is what --resume asks for in the end (every run done),
@@ -168,11 +168,13 @@ def _check_same(stored: Path, text: str, what: str) -> None:
     if before == text:
         return
     diff = [
-        line
+        line.replace("@@ ", "").replace(" @@", ":")  # "-12 +12:" (line numbers).
+        if line.startswith("@@")
+        else line
         for line in difflib.unified_diff(
             before.splitlines(), text.splitlines(), lineterm="", n=0
         )
-        if line[:1] in "+-" and line[:3] not in ("+++", "---")
+        if line[:3] not in ("+++", "---")
     ]
     shown = "; ".join(diff[:6]) + ("; ..." if len(diff) > 6 else "")
     raise VicDrakeError(
@@ -304,7 +306,9 @@ def run_campaign(
     emit = progress or (lambda _line: None)
     texts = {
         CAMPAIGN_SPEC_FILE: _spec_text(spec, base_path),
-        CAMPAIGN_BASE_FILE: dumps_scenario(base),
+        # The file as written, not as loaded: a code change that adds a
+        # field (its default in every dump) is not a change of the base.
+        CAMPAIGN_BASE_FILE: Path(base_path).read_text(),
     }
     done = _check_out(out, texts, plans, resume, emit, allow_code_change)
     todo = [p for p in plans if p.run_id not in done]

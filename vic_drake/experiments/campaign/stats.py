@@ -201,20 +201,20 @@ def _discordant(a: np.ndarray, b: np.ndarray) -> dict:
     }
 
 
-#: The factors that make a run's arm (its controller label:
-#: :func:`~vic_drake.experiments.campaign.plan.controller_arm`).
-ARM_FACTORS = ("controller", "stiffness_source", "watchdog.enabled")
-
-
 def _pair_keys(ok: pd.DataFrame, grid_size: int) -> pd.Series:
-    """A run's pair: its grid round and its values of every factor that is
-    not an arm's (in a paired round the drawn ones are shared, the other
-    grid factors' pick the cell)."""
+    """A run's pair: its grid round and its values of every factor that
+    varies within an arm (the other grid factors' cells; the drawn factors,
+    shared in a paired round). A factor that holds one value per arm makes
+    the arm (``controller``, ``controller.reference.controller``,
+    ``watchdog.enabled``, ...) and is left out, or no two arms would pair."""
     key = (ok["index"] // grid_size).astype(str)
-    arm_columns = {f"factor.{name}" for name in ARM_FACTORS}
+    arms = ok["factor.controller"].astype(str)
     for column in sorted(ok.columns):
-        if column.startswith("factor.") and column not in arm_columns:
-            key = key + "|" + ok[column].astype(str)
+        if not column.startswith("factor.") or column == "factor.controller":
+            continue
+        values = ok[column].astype(str)
+        if values.groupby(arms).nunique().max() > 1:
+            key = key + "|" + values
     return key
 
 
