@@ -158,3 +158,35 @@ def test_a_sensor_that_dies_in_contact_stops_the_scan(mode):
     else:
         assert abs(z[-1] - z[t <= 1.0][-1]) < 1e-4  # The arm froze in place.
         assert force[-1] > 1.0
+
+
+def test_under_breathing_the_maps_eps_dot_misses_the_chests_velocity():
+    """The map is static, so under breathing the controller's penetration
+    rate (eq. 10 on the map: its surface velocity minus the tip's) is the
+    true rate minus the chest's velocity, as on the paper's rig. With 1 cm
+    at 0.33 Hz the probe rides the chest (true rate ~1 mm/s RMS), the
+    controller reads ~7.5 mm/s against the chest's motion, and the damping
+    term lambda eps_dot is ~11 % of kappa at its p95 (measured)."""
+    s = _short()
+    b = s.variations.motion.breathing
+    b.amplitude_m, b.frequency_hz, b.irregularity = 0.01, 0.33, 0.0
+    result = run_scan(s, duration_s=7.0)
+    df, rig = result.df, result.rig
+    t = df["t_s"].to_numpy()
+    held = (t > 3.0) & (df["in_contact"].to_numpy() > 0.5)  # After the approach.
+    assert held.sum() > 1000
+    controller = (
+        rig["surface_velocity_m_per_s"] - rig["controller_vz_m_per_s"]
+    ).to_numpy()
+    chest = np.gradient(df["phantom_lift_m"].to_numpy(), t)
+    true = np.gradient(df["penetration_m"].to_numpy(), t)
+    c, v, e = controller[held], chest[held], true[held]
+    # The kinematic identity: the controller's rate lacks the chest's velocity.
+    assert np.max(np.abs(c - (e - v))) < 5e-4
+    assert np.corrcoef(c, -v)[0, 1] > 0.95
+    rms = lambda x: float(np.sqrt(np.mean(x**2)))  # noqa: E731
+    assert rms(e) < 0.3 * rms(c)  # The probe follows: the true rate is small.
+    # How much of the reference that is: lambda |eps_dot| / kappa.
+    share = (rig["lambda_N_s_per_m_beta1"] / rig["kappa_N_per_m_beta"]).to_numpy()
+    share = share[held] * np.abs(c)
+    assert 0.05 < np.percentile(share, 95) < 0.2
