@@ -6,6 +6,8 @@ names what is wrong and what is allowed. The command line prints the message
 and exits with status 2 instead of a traceback.
 """
 
+import dataclasses
+import difflib
 import math
 
 
@@ -58,6 +60,15 @@ def check_number(
     return v
 
 
+def field_hint(name: str, fields) -> str:
+    """ "; did you mean a, b? Its fields: ..." for an unknown field ``name``
+    among ``fields`` (the close names first, when there are any)."""
+    fields = list(fields)
+    near = difflib.get_close_matches(name, fields, n=3, cutoff=0.5)
+    hint = f"; did you mean {', '.join(near)}?" if near else ""
+    return hint + (f" Its fields: {', '.join(fields)}" if fields else "")
+
+
 def check_known_attributes(obj, owner: str) -> None:
     """Refuses an attribute that is not a field, on a dataclass and on every
     dataclass in its fields (lists and dicts of them included).
@@ -69,19 +80,14 @@ def check_known_attributes(obj, owner: str) -> None:
     Raises:
         VicDrakeError: "<owner>.<path> has no field 'x'; did you mean ...".
     """
-    import dataclasses
-    import difflib
-
     if not dataclasses.is_dataclass(obj) or isinstance(obj, type):
         return
     fields = [f.name for f in dataclasses.fields(obj)]
     for name in getattr(obj, "__dict__", {}):
         if name not in fields and not name.startswith("_"):
-            near = difflib.get_close_matches(name, fields, n=3, cutoff=0.5)
-            hint = f"; did you mean {', '.join(near)}?" if near else ""
             raise VicDrakeError(
                 f"{owner} has no field {name!r} (set in code, it would be "
-                f"ignored){hint} Its fields: {', '.join(fields)}"
+                f"ignored){field_hint(name, fields)}"
             )
     for name in fields:
         value = getattr(obj, name)

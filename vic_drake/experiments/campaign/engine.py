@@ -137,12 +137,14 @@ def _check_out(
             )
         planned = {p.run_id for p in plans}
         stored = {p.stem for p in (out / "rows").glob("run_*.json")} & planned
-        failed = {r for r in stored if _row(out, r).get("status") == "error"}
+        rows = {r: _row(out, r) for r in sorted(stored)}  # Each read once.
+        failed = {r for r, row in rows.items() if row.get("status") == "error"}
         done = stored - failed
         if not allow_code_change and len(done) < len(planned):
             # Runs to add: they must be the stored rows' code's. (With none
             # left, a resume only summarises the rows again.)
-            _check_stored_code(out, done)
+            kept = pd.DataFrame([rows[r] for r in sorted(done)])
+            _check_stored_code(out, _code_counts(kept))
         if failed:
             emit(
                 f"{len(failed)} run{'s' if len(failed) > 1 else ''} of {str(out)!r} "
@@ -187,19 +189,11 @@ def _check_same(stored: Path, text: str, what: str) -> None:
 UNKNOWN_CODE = "unknown (a row written before rows recorded their code)"
 
 
-def _stored_codes(out: Path, run_ids) -> dict[str, int]:
-    """{code_id: rows} of the stored rows ``run_ids``."""
-    counts: dict[str, int] = {}
-    for run_id in sorted(run_ids):
-        code = _row(out, run_id).get("code_id") or UNKNOWN_CODE
-        counts[code] = counts.get(code, 0) + 1
-    return counts
-
-
-def _check_stored_code(out: Path, run_ids) -> None:
-    """Refuses a resume whose code is not the stored rows' code."""
+def _check_stored_code(out: Path, counts: dict[str, int]) -> None:
+    """Refuses a resume whose code is not the stored rows' (``counts``:
+    :func:`_code_counts` of the rows it keeps)."""
     here = code_id()
-    other = {c: n for c, n in _stored_codes(out, run_ids).items() if c != here}
+    other = {c: n for c, n in counts.items() if c != here}
     if other:
         stored = "; ".join(f"{n} by {c}" for c, n in other.items())
         raise VicDrakeError(
@@ -300,8 +294,7 @@ def run_campaign(
     if workers is not None and (isinstance(workers, bool) or workers < 1):
         raise VicDrakeError(f"--workers must be >= 1; got {workers!r}")
     spec, base_path = load_campaign_spec(spec_path)
-    base = load_scenario(base_path)
-    plans = plan_campaign(spec, base)
+    plans = plan_campaign(spec, load_scenario(base_path))
     out = Path(out)
     emit = progress or (lambda _line: None)
     texts = {

@@ -8,11 +8,10 @@ with the same calls, so both see the same coercions and the same errors.
 from __future__ import annotations
 
 import copy
-import difflib
 import re
 from dataclasses import fields, is_dataclass
 
-from vic_drake.errors import VicDrakeError
+from vic_drake.errors import VicDrakeError, field_hint
 from vic_drake.experiments.paper_scenarios import synthetic_scenario
 from vic_drake.paper import CONTROLLERS
 from vic_drake.scenario import Scenario
@@ -38,12 +37,10 @@ def _slot(scenario: Scenario, path: str) -> tuple[object, str, int | None]:
         name, index = (m.group(1), int(m.group(2))) if m else (part, None)
         names = [f.name for f in fields(obj)] if is_dataclass(obj) else []
         if name not in names:
-            near = difflib.get_close_matches(name, names, n=3, cutoff=0.5)
             where = ".".join(parts[:k]) or "the scenario"
             raise VicDrakeError(
                 f"factor {path!r}: {where} has no field {name!r}"
-                + (f"; did you mean {', '.join(near)}?" if near else "")
-                + (f" Its fields: {', '.join(names)}" if names else "")
+                + field_hint(name, names)
             )
         if index is not None:
             seq = getattr(obj, name)

@@ -10,23 +10,23 @@ from vic_drake.jsonio import to_json
 from vic_drake.reproduce.context import RunContext
 from vic_drake.reproduce.report import ReportTable
 
-#: Metrics of vic_drake.analysis.claims.scan_metrics shown in the scan tables,
-#: with the column's name and the factor to it (a penetration reads in mm).
-_TABLE_COLUMNS = (
-    ("force_rmse_N", "force_rmse_N", 1.0),
-    ("force_range_N", "force_range_N", 1.0),
-    ("peak_force_N", "peak_force_N", 1.0),
-    ("lifted_off", "lifted_off", None),
-    (
-        "penetration_error_off_ribs_median_m",
-        "penetration_error_off_ribs_median_mm",
-        1e3,
-    ),
-    ("force_on_ribs_p99_N", "force_on_ribs_p99_N", 1.0),
-    ("n_contact_losses", "n_contact_losses", None),
-    ("fraction_at_k_min_during_loss", "fraction_at_k_min_during_loss", 1.0),
-    ("tank_min_J", "tank_min_J", 1.0),
-    ("tank_power_min_W", "tank_power_min_W", 1.0),
+#: Metrics of vic_drake.analysis.claims.scan_metrics shown in the scan tables.
+_TABLE_KEYS = (
+    "force_rmse_N",
+    "force_range_N",
+    "peak_force_N",
+    "lifted_off",
+    "penetration_error_off_ribs_median_m",
+    "force_on_ribs_p99_N",
+    "n_contact_losses",
+    "fraction_at_k_min_during_loss",
+    "tank_min_J",
+    "tank_power_min_W",
+)
+
+#: (key, column name, factor to it): a length in m reads in mm.
+_TABLE_COLUMNS = tuple(
+    (k, k[:-2] + "_mm", 1e3) if k.endswith("_m") else (k, k, None) for k in _TABLE_KEYS
 )
 
 
